@@ -1,0 +1,28 @@
+# Quick start: `make demo` and `make test` (both create .venv on first use).
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+# Kernel cache shared by every run and test of this checkout (compile once, reuse).
+export WARP_CACHE_PATH ?= $(CURDIR)/.warp_cache
+
+.PHONY: demo test venv lint clean
+
+$(BIN)/tightknot: pyproject.toml
+	$(PY) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e ".[fem,test]"
+	touch $(BIN)/tightknot
+
+venv: $(BIN)/tightknot
+
+demo: venv
+	$(BIN)/tightknot demo --out runs/demo
+
+test: venv
+	$(BIN)/python -m pytest -q
+
+lint: venv
+	$(BIN)/ruff check .
+
+clean:
+	rm -rf $(VENV) .warp_cache runs

@@ -1,0 +1,1 @@
+"""tightknot.fem"""
