@@ -120,7 +120,15 @@ def test_entities_steps_positions_and_blueprint(tmp_path: Path) -> None:
     # Scalars are stored as float64: exact.
     assert np.array_equal(force, 0.5 * np.arange(STEPS))
 
-    assert rrd_read.has_blueprint(rrd)
+    # Default layout: the scene in 3D, one time-series view per plot group ("energy/*" share one).
+    assert rrd_read.blueprint_views(rrd) == [
+        ("3D", "/"),
+        ("TimeSeries", "/plots/energy"),
+        ("TimeSeries", "/plots/lambda_oc"),
+        ("TimeSeries", "/plots/load"),
+        ("TimeSeries", "/plots/newton_iterations"),
+        ("TimeSeries", "/plots/pulling_force"),
+    ]
 
 
 def test_tube_is_one_strip_per_edge_with_varying_colours(tmp_path: Path) -> None:
@@ -296,3 +304,13 @@ def test_plot_groups() -> None:
 def test_missing_folder_fails_at_construction(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError):
         RerunLogger(tmp_path / "nope" / "run.rrd")
+
+
+def test_rerun_off_fails_clearly_at_construction(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # rerun reads RERUN when each stream is created, so this does not leak into other tests.
+    monkeypatch.setenv("RERUN", "off")
+    with pytest.raises(RuntimeError, match="RERUN=off"):
+        RerunLogger(tmp_path / "off.rrd")
+    assert files_in(tmp_path) == []

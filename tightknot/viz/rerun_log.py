@@ -236,7 +236,11 @@ def default_blueprint(groups: list[str] | None = None) -> rrb.Blueprint:
         plots = [rrb.TimeSeriesView(name=PLOTS_ROOT, origin=f"/{PLOTS_ROOT}")]
     return rrb.Blueprint(
         rrb.Horizontal(scene, rrb.Grid(*plots), column_shares=[3, 2]),
-        collapse_panels=True,
+        # Side panels folded to leave room for the views; the time panel stays open on the
+        # load_step timeline, since scrubbing the steps is the point of the log.
+        rrb.BlueprintPanel(state="collapsed"),
+        rrb.SelectionPanel(state="collapsed"),
+        rrb.TimePanel(timeline=LOAD_STEP_TIMELINE, state="expanded"),
     )
 
 
@@ -286,6 +290,13 @@ class RerunLogger:
                 make_default=False,
                 make_thread_default=False,
             )
+            if not rr.is_enabled(recording=self._rec):
+                # RERUN=off in the environment disables every stream: fail here, clearly,
+                # rather than produce no file (or a confusing error at close).
+                raise RuntimeError(
+                    "rerun logging is disabled (RERUN=off in the environment); unset RERUN "
+                    "or run without a log path"
+                )
             self._rec.save(self._tmp)
         except BaseException:
             self._discard()

@@ -125,6 +125,25 @@ def unpack_rgba(packed: list[int] | np.ndarray) -> np.ndarray:
     return ((c[:, None] >> shifts) & 0xFF).astype(np.uint8)
 
 
-def has_blueprint(rrd: str | os.PathLike[str]) -> bool:
-    """True when the file carries a blueprint store (the default layout)."""
-    return len(RrdReader(rrd).blueprints()) > 0
+def blueprint_views(rrd: str | os.PathLike[str]) -> list[tuple[str, str]]:
+    """Sorted ``(view class, origin)`` of the views in the file's blueprint(s).
+
+    View classes are rerun's identifiers, e.g. ``"3D"`` and ``"TimeSeries"``.
+    """
+    reader = RrdReader(rrd)
+    views: list[tuple[str, str]] = []
+    for store in reader.blueprints():
+        for chunk in reader.stream(store=store):
+            batch = chunk.to_record_batch()
+            names = batch.schema.names
+            if (
+                "ViewBlueprint:class_identifier" not in names
+                or "ViewBlueprint:space_origin" not in names
+            ):
+                continue
+            kinds = batch.column("ViewBlueprint:class_identifier").to_pylist()
+            origins = batch.column("ViewBlueprint:space_origin").to_pylist()
+            for kind, origin in zip(kinds, origins, strict=True):
+                if kind and origin:
+                    views.append((kind[0], origin[0]))
+    return sorted(views)
