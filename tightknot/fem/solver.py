@@ -1,0 +1,135 @@
+"""Quasi-static Newton solver for a nearly incompressible solid with rigid penalty contact.
+
+Displacement control: every load parameter moves the rigid surfaces (all Dirichlet
+conditions are homogeneous symmetry or end conditions), Newton's method solves for the
+displacements, and a failed increment is cut back (halved) from the last checkpoint.
+The sparse symmetric system is factorised by SuperLU with diagonal pivoting off and the
+symmetric mode on (2 to 3 times faster than the default on 3D hexahedral matrices, as
+measured by a scout on this project's meshes).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from .contact import PenaltyContact
+
+
+class NewtonFailure(RuntimeError):
+    """An increment did not converge even after the allowed cutbacks."""
+
+
+@dataclass
+class Problem:
+    """A solid body, its rigid contacts and its fixed (zero) degrees of freedom.
+
+    ``field`` is the FElupe ``FieldContainer`` (displacement first), ``solid`` the FElupe
+    solid body, ``fixed`` a boolean mask over the dofs (point-major: point * dim + axis),
+    ``force_scale`` [N or N/m] a force used for the relative convergence test.
+    """
+
+    field: Any
+    solid: Any
+    contacts: list[PenaltyContact]
+    fixed: np.ndarray
+    force_scale: float
+    iterations: list[int] = field(default_factory=list)
+
+    @property
+    def mesh(self) -> Any:
+        """The FElupe mesh of the solid."""
+        return self.field.region.mesh
+
+    @property
+    def dim(self) -> int:
+        """Number of displacement components per point."""
+        return int(self.field[0].values.shape[1])
+
+    def positions(self) -> np.ndarray:
+        """Current point coordinates [m], shape (npoints, dim)."""
+        return self.mesh.points + self.field[0].values
+
+    def assemble(self) -> tuple[np.ndarray, sp.csr_matrix]:
+        """Residual vector [N] and tangent matrix [N/m] of solid plus contacts."""
+        solid = self.solid
+        r = np.asarray(solid.assemble.vector(self.field).todense()).ravel()
+        k = solid.assemble.matrix().tocoo()
+        rows, cols, data = [k.row], [k.col], [k.data]
+        x = self.positions()
+        dim = self.dim
+        for c in self.contacts:
+            force, blocks, _, _ = c.evaluate(x[c.points])
+            dof = c.points[:, None] * dim + np.arange(dim)[None, :]  # (m, dim)
+            np.add.at(r, dof.ravel(), force.ravel())
+            rows.append(np.repeat(dof, dim, axis=1).ravel())
+            cols.append(np.tile(dof, (1, dim)).ravel())
+            data.append(blocks.ravel())
+        n = r.size
+        matrix = sp.coo_matrix(
+            (np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
+        ).tocsr()
+        return r, matrix
+
+    def newton(self, tol: float = 1e-8, maxiter: int = 30) -> int:
+        """Solve the current increment in place; return the number of iterations.
+
+        Converged when the free residual norm is below ``tol`` times the larger of the
+        reaction norm and 1e-3 ``force_scale`` and the last correction is below 1e-9 of
+        the mesh size (both: a small residual alone can hide a stalled, tiny-penalty step).
+        """
+        free = ~self.fixed
+        size = np.ptp(self.mesh.points, axis=0).max()
+        for it in range(1, maxiter + 1):
+            r, k = self.assemble()
+            r_free = r[free]
+            reaction = np.linalg.norm(r[self.fixed]) + sum(
+                np.linalg.norm(c.evaluate(self.positions()[c.points])[0]) for c in self.contacts
+            )
+            scale = max(reaction, 1e-3 * self.force_scale)
+            if not np.all(np.isfinite(r_free)):
+                raise NewtonFailure("non-finite residual")
+            k_free = k[free][:, free].tocsc()
+            lu = splu(k_free, diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+            du = np.zeros_like(r)
+            du[free] = -lu.solve(r_free)
+            if not np.all(np.isfinite(du)):
+                raise NewtonFailure("non-finite correction")
+            self.field[0].values[:] += du.reshape(-1, self.dim)
+            if np.linalg.norm(r_free) <= tol * scale and np.abs(du).max() <= 1e-9 * size:
+                return it
+        raise NewtonFailure(f"no convergence in {maxiter} iterations")
+
+    def run(self, loads: np.ndarray, apply: Callable[[float], None],
+            measure: Callable[[float], dict[str, Any]], max_cutbacks: int = 6) -> list[dict]:
+        """Step through the load parameters ``loads`` (increasing), return measurements.
+
+        ``apply(load)`` moves the rigid surfaces; ``measure(load)`` returns a dict of
+        outputs of the converged state. A failed increment is halved up to
+        ``max_cutbacks`` times (restarting from the last converged checkpoint).
+        """
+        results = []
+        current = 0.0
+        for target in loads:
+            cutbacks = 0
+            while current < target:
+                trial = target if cutbacks == 0 else current + (target - current) / 2**cutbacks
+                checkpoint = self.solid.checkpoint()
+                apply(trial)
+                try:
+                    self.iterations.append(self.newton())
+                    current = trial
+                    if current < target:
+                        cutbacks = max(cutbacks - 1, 0)
+                except (NewtonFailure, RuntimeError, FloatingPointError) as err:
+                    self.solid.restore(checkpoint)
+                    cutbacks += 1
+                    if cutbacks > max_cutbacks:
+                        raise NewtonFailure(f"increment to load {target:.4g} failed: {err}")
+            results.append(measure(target))
+        return results
