@@ -192,6 +192,7 @@ def min_nonlocal_distance(
         return float("inf"), float("nan"), float("nan")
     d = np.linalg.norm(p[pairs[:, 0]] - p[pairs[:, 1]], axis=1)
     best = pairs[np.argmin(d)]
+    lengths = edge_lengths(p, closed)
     n = p.shape[0]
     dmin = float(d.min())
     sa, sb = s[best[0]], s[best[1]]
@@ -200,6 +201,13 @@ def min_nonlocal_distance(
         for ib in (best[1] - 1, best[1]):
             if not closed and (ia < 0 or ib < 0 or ia >= n - 1 or ib >= n - 1):
                 continue
+            ends_a = np.array([s[ia % n], s[ia % n] + lengths[ia % n]])
+            ends_b = np.array([s[ib % n], s[ib % n] + lengths[ib % n]])
+            sep = np.abs(ends_a[:, None] - ends_b[None, :])
+            if closed:
+                sep = np.minimum(sep, length - sep)
+            if sep.min() <= exclusion_arc_length:
+                continue  # edges that share a local stretch of curve are not a non-local pair
             a0, a1 = p[ia % n], p[(ia + 1) % n]
             b0, b1 = p[ib % n], p[(ib + 1) % n]
             dseg = _segment_distance(a0, a1, b0, b1)
