@@ -99,9 +99,9 @@ def closed_knot_profile(
     Origin of s: the 3-fold symmetric knot has 2-fold axes through the middles of its outer
     and inner segments (its symmetry group is D3); s = 0 is put at the middle of an outer
     segment, found as the maximum of rho(S) near a maximum of the third Fourier harmonic of
-    rho(S) (robust to noise), choosing among the three the one with the largest rho so the
-    choice does not depend on where the vertex numbering starts. Outer (inner) segments are
-    the three local maxima (minima) of rho within L/6 of the harmonic's maxima (minima).
+    rho(S) (robust to noise); of the three, the first along the vertex numbering. Outer
+    (inner) segments are the three local maxima (minima) of rho within L/6 of the harmonic's
+    maxima (minima).
     Arrays are returned ordered by s in [-L0/(2 D0), L0/(2 D0)).
     """
     length = total_length(points, True)
@@ -115,8 +115,10 @@ def closed_knot_profile(
              for k in range(3)]
     inner = [_refine_extremum(S, rho_raw, phase + (k + 0.5) * third, length / 6, length, False)
              for k in range(3)]
-    rho_at = [np.interp(o, S, rho_raw, period=length) for o in outer]
-    origin = outer[int(np.argmax(rho_at))]
+    # The three outer middles are equivalent by symmetry; taking the largest rho would
+    # flip between them with round-off on a symmetric knot, so take the first one along the
+    # vertex numbering (stable under rotation; a cyclic shift moves s = 0 to an equivalent one).
+    origin = min(outer)
     # In-plane orientation: X axis toward the origin point (rotation about e_z only).
     px, py = np.interp(origin, S, xyz[:, 0], period=length), np.interp(origin, S, xyz[:, 1],
                                                                      period=length)
