@@ -1,0 +1,21 @@
+"""Shared FEM results: each scene is solved once per test session (they cost seconds)."""
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def squeeze_plane_strain_convergence():
+    """Plane-strain squeeze, coarse mesh plus the three-mesh table (about 10 s)."""
+    pytest.importorskip("felupe")
+    from tightknot.fem import run_scene
+
+    return run_scene("squeeze", mesh="coarse", model="plane_strain", convergence=True)
+
+
+@pytest.fixture(scope="session")
+def indent_coarse():
+    """Indent on the coarse mesh (1080 hexahedra, about 15 s on 2 cores)."""
+    pytest.importorskip("felupe")
+    from tightknot.fem import run_scene
+
+    return run_scene("indent", mesh="coarse", convergence=False)

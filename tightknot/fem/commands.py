@@ -1,0 +1,110 @@
+"""Command-line subcommands of the FEM part: ``fem SCENE`` and ``calibrate``.
+
+The CLI owner calls :func:`register` from ``tightknot/cli.py``; each parser gets a
+``handler`` default (``args.handler(args) -> int``): 0 ok, 2 bad input or FElupe missing
+(one line on stderr, with the install hint when FElupe is missing).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from ._backend import FelupeMissingError
+
+_FEM_EXAMPLES = """examples:
+  tightknot fem squeeze                         # plane strain, coarse mesh, 3 meshes table
+  tightknot fem squeeze --mesh medium --json out/squeeze.json
+  tightknot fem squeeze --model 3d --ends free  # 3D segment with free ends
+  tightknot fem indent --mesh coarse --no-convergence
+"""
+
+_CAL_EXAMPLES = """examples:
+  tightknot calibrate                           # medium meshes, writes the shipped law
+  tightknot calibrate --mesh coarse --out /tmp/contact_law.json
+"""
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``fem`` and ``calibrate`` subcommands to an argparse ``subparsers``."""
+    fem = subparsers.add_parser(
+        "fem", help="run a small 3D solid FEM scene (needs tightknot[fem])",
+        description="Run a FEM contact scene of a nearly incompressible neo-Hookean rod "
+                    "(E = 1.25 MPa, D0 = 8.5 mm) and print or save its JSON result.",
+        epilog=_FEM_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    fem.add_argument("scene", help="squeeze | indent | wrap (wrap: not implemented yet)")
+    fem.add_argument("--mesh", default="coarse", help="coarse | medium | fine")
+    fem.add_argument("--approach", type=float, default=0.3,
+                     help="total approach over D0, in (0, 1) (default 0.3)")
+    fem.add_argument("--steps", type=int, default=None, help="number of load steps")
+    fem.add_argument("--model", default=None, help="squeeze only: plane_strain | 3d")
+    fem.add_argument("--ends", default=None, help="squeeze 3d only: plane | free")
+    fem.add_argument("--no-convergence", action="store_true",
+                     help="skip the three-mesh convergence table")
+    fem.add_argument("--json", default=None, metavar="FILE",
+                     help="write the result to FILE (atomically) instead of stdout")
+    fem.set_defaults(handler=_run_fem)
+
+    cal = subparsers.add_parser(
+        "calibrate", help="calibrate the radial-compliance contact law from the FEM",
+        description="Run squeeze (plane strain, 3D plane and free ends) and indent, fit "
+                    "the per-side power laws and write contact_law.json.",
+        epilog=_CAL_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    cal.add_argument("--mesh", default="medium", help="coarse | medium | fine")
+    cal.add_argument("--out", default=None, metavar="PATH",
+                     help="output JSON (default: the package's data/contact_law.json)")
+    cal.set_defaults(handler=_run_calibrate)
+
+
+def _fail(message: str) -> int:
+    print(f"tightknot: {message}", file=sys.stderr)
+    return 2
+
+
+def _check_out(path: str | None) -> str | None:
+    if path is not None and not Path(path).resolve().parent.is_dir():
+        return f"output folder does not exist: {Path(path).parent}"
+    return None
+
+
+def _run_fem(args: argparse.Namespace) -> int:
+    from . import run_scene
+    from .scenes._common import finite
+
+    problem = _check_out(args.json)
+    if problem:
+        return _fail(problem)
+    options: dict[str, Any] = {"convergence": not args.no_convergence}
+    if args.model is not None:
+        options["model"] = args.model
+    if args.ends is not None:
+        options["ends"] = args.ends
+    try:
+        result = run_scene(args.scene, mesh=args.mesh, max_approach_over_d0=args.approach,
+                           steps=args.steps, **options)
+    except (ValueError, FelupeMissingError) as err:
+        return _fail(str(err))
+    if args.json is None:
+        print(json.dumps(finite(result), indent=2, allow_nan=False))
+    else:
+        from tightknot.atomic import write_json_atomic
+
+        write_json_atomic(args.json, result)
+    return 0
+
+
+def _run_calibrate(args: argparse.Namespace) -> int:
+    problem = _check_out(args.out)
+    if problem:
+        return _fail(problem)
+    try:
+        from .calibration import LAW_PATH, write_law
+
+        law = write_law(args.out or LAW_PATH, mesh=args.mesh)
+    except (ValueError, FelupeMissingError) as err:
+        return _fail(str(err))
+    print(json.dumps({k: law[k] for k in law if k.startswith(("k_", "p_", "c_"))}, indent=2))
+    return 0
