@@ -1,0 +1,188 @@
+"""One damped Newton loop for every solver (static, continuation, implicit dynamics).
+
+Each iteration solves ``(H + mu D) d = -g`` with D the absolute diagonal of H (a
+Levenberg-Marquardt shift, Nocedal & Wright 2006 sec. 3.4) raised whenever the Hessian
+proves not positive definite along the step (``d.H d <= 0``), the step is not a descent
+direction, or the factorization fails; the step is then cut to the largest fraction the
+problem allows (no passing through, from the contact layer) and a backtracking Armijo line
+search on the total potential follows (Nocedal & Wright Alg. 3.1).
+
+Convergence: the scaled residual (forces over EI/L^2, moments over EI/L) is below
+``residual_tol``. The step size is reported and stagnation (tiny steps without a small
+residual) ends the loop as a failure. A failed solve returns a result saying so, never NaN.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+import scipy.sparse as sp
+
+from tightknot.solvers.linear import factorize
+
+
+class NewtonProblem(Protocol):
+    """What the Newton loop needs of a problem (see RodSystem)."""
+
+    def evaluate(
+        self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True
+    ) -> tuple[float, np.ndarray | None, sp.csc_matrix | None]: ...
+
+    def accept(self, u: np.ndarray) -> None: ...
+
+    def max_step(self, u: np.ndarray, du: np.ndarray) -> float: ...
+
+    def residual_norm(self, g: np.ndarray) -> float: ...
+
+    def step_norm(self, du: np.ndarray) -> float: ...
+
+    def energy_roundoff(self) -> float: ...
+
+
+@dataclass
+class NewtonOptions:
+    """Settings of the Newton loop.
+
+    Attributes:
+        residual_tol: converged when the scaled residual is below this [-].
+        step_tol: a step below this (scaled) with the residual still large is stagnation.
+        max_iterations: iteration limit.
+        armijo: sufficient-decrease constant of the line search.
+        max_backtracks: line-search halvings before the shift is raised instead.
+        shift_initial: first relative shift mu when one is needed.
+        shift_max: beyond this shift the solve gives up.
+    """
+
+    residual_tol: float = 1e-8
+    step_tol: float = 1e-13
+    max_iterations: int = 100
+    armijo: float = 1e-4
+    max_backtracks: int = 30
+    shift_initial: float = 1e-8
+    shift_max: float = 1e8
+
+    def __post_init__(self) -> None:
+        for name in ("residual_tol", "step_tol", "armijo", "shift_initial", "shift_max"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+        if self.max_iterations < 1:
+            raise ValueError(f"max_iterations must be >= 1, got {self.max_iterations}")
+
+
+@dataclass
+class NewtonResult:
+    """Outcome of a Newton solve.
+
+    Attributes:
+        converged: the residual test passed.
+        iterations: Newton iterations taken.
+        residual: final scaled residual [-].
+        step: last scaled step [-].
+        energy: final total potential [J].
+        reason: why the loop stopped ("converged", "max_iterations", "stagnated",
+            "line_search_failed", "non_finite").
+        history: scaled residual after each iteration.
+    """
+
+    converged: bool
+    iterations: int
+    residual: float
+    step: float
+    energy: float
+    reason: str
+    history: list[float] = field(default_factory=list)
+
+
+def newton_solve(
+    problem: NewtonProblem, u0: np.ndarray, options: NewtonOptions | None = None
+) -> NewtonResult:
+    """Minimise the problem's potential from ``u0``; accepted iterates go to the problem."""
+    opt = options or NewtonOptions()
+    u = np.array(u0, dtype=np.float64)
+    energy, g, h = problem.evaluate(u, True, True)
+    if not (math.isfinite(energy) and np.isfinite(g).all()):
+        return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
+    res = problem.residual_norm(g)
+    history = [res]
+    mu = 0.0
+    step = math.inf
+    if res <= opt.residual_tol:
+        problem.accept(u)
+        return NewtonResult(True, 0, res, 0.0, energy, "converged", history)
+    for it in range(1, opt.max_iterations + 1):
+        accepted = False
+        diag = np.abs(h.diagonal())
+        diag = np.maximum(diag, 1e-12 * (diag.max() if diag.size else 1.0))
+        while not accepted:
+            d = _shifted_direction(h, g, mu, diag)
+            if d is None or not _acceptable(d, g, h):
+                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
+                if mu > opt.shift_max:
+                    problem.accept(u)
+                    return NewtonResult(False, it, res, step, energy, "line_search_failed",
+                                        history)
+                continue
+            alpha = min(1.0, problem.max_step(u, d))
+            slope = float(g @ d)
+            roundoff = problem.energy_roundoff()
+            for _ in range(opt.max_backtracks):
+                trial = u + alpha * d
+                e_trial, _, _ = problem.evaluate(trial, False, False)
+                if not math.isfinite(e_trial):
+                    alpha *= 0.5
+                    continue
+                if e_trial <= energy + opt.armijo * alpha * slope:
+                    accepted = True
+                    break
+                # Near the minimum the predicted decrease is below the round-off of the
+                # energy, which can then not rank the iterates: accept the step if the
+                # energy did not grow beyond that round-off (the quadratic model is exact).
+                if -alpha * slope <= roundoff and e_trial <= energy + roundoff:
+                    accepted = True
+                    break
+                alpha *= 0.5
+            if not accepted:
+                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
+                if mu > opt.shift_max:
+                    problem.accept(u)
+                    return NewtonResult(False, it, res, step, energy, "line_search_failed",
+                                        history)
+        du = alpha * d
+        u = u + du
+        step = problem.step_norm(du)
+        problem.accept(u)
+        energy, g, h = problem.evaluate(u, True, True)
+        if not (math.isfinite(energy) and np.isfinite(g).all()):
+            return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
+        res = problem.residual_norm(g)
+        history.append(res)
+        # Relax the shift after a successful step (trust grows back toward pure Newton).
+        mu = 0.0 if mu <= opt.shift_initial else mu / 100.0
+        if res <= opt.residual_tol:
+            return NewtonResult(True, it, res, step, energy, "converged", history)
+        if step <= opt.step_tol:
+            return NewtonResult(False, it, res, step, energy, "stagnated", history)
+    return NewtonResult(False, opt.max_iterations, res, step, energy, "max_iterations", history)
+
+
+def _shifted_direction(
+    h: sp.csc_matrix, g: np.ndarray, mu: float, diag: np.ndarray
+) -> np.ndarray | None:
+    a = h if mu == 0.0 else (h + sp.diags(mu * diag, format="csc"))
+    try:
+        d = factorize(a).solve(-g)
+    except RuntimeError:  # exactly singular
+        return None
+    return d if np.isfinite(d).all() else None
+
+
+def _acceptable(d: np.ndarray, g: np.ndarray, h: sp.csc_matrix) -> bool:
+    # A descent direction along which the Hessian has positive curvature; otherwise the
+    # Hessian is not positive definite there and the shift must grow.
+    slope = float(g @ d)
+    curv = float(d @ (h @ d))
+    return slope < 0.0 and curv > 0.0

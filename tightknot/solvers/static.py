@@ -1,0 +1,129 @@
+"""Quasi-static equilibrium along a load path, by load continuation.
+
+The load parameter t goes from 0 to 1 in steps; each step is a Newton solve started from
+the previous equilibrium. A step that fails is halved (the state is restored), an easy one
+lets the next grow, so the path passes where a fixed step would not.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton_solve
+from tightknot.solvers.system import RodSystem
+
+
+@dataclass
+class ContinuationOptions:
+    """Settings of the load continuation.
+
+    Attributes:
+        steps: initial number of equal steps from t = 0 to 1.
+        min_step: smallest step in t before giving up.
+        max_step: largest step in t.
+        grow_below: a step that converged in fewer Newton iterations than this doubles the next.
+        newton: options of each Newton solve.
+    """
+
+    steps: int = 1
+    min_step: float = 1e-4
+    max_step: float = 1.0
+    grow_below: int = 6
+    newton: NewtonOptions = field(default_factory=NewtonOptions)
+
+    def __post_init__(self) -> None:
+        if self.steps < 1:
+            raise ValueError(f"steps must be >= 1, got {self.steps}")
+        if not (0 < self.min_step <= self.max_step <= 1):
+            raise ValueError("need 0 < min_step <= max_step <= 1")
+
+
+@dataclass
+class StepRecord:
+    """One converged load step."""
+
+    t: float
+    newton: NewtonResult
+
+
+@dataclass
+class StaticResult:
+    """Outcome of a continuation.
+
+    Attributes:
+        converged: every step to t = 1 converged (and no callback refused a step).
+        t: the load parameter reached.
+        steps: the converged steps.
+        newton_iterations: total Newton iterations, failed attempts included.
+        failure: why it stopped early ("" when converged).
+        wall_time_s: wall-clock time [s].
+    """
+
+    converged: bool
+    t: float
+    steps: list[StepRecord]
+    newton_iterations: int
+    failure: str
+    wall_time_s: float
+
+
+StepCallback = Callable[[RodSystem, StepRecord], str | None]
+
+
+def solve_static(
+    system: RodSystem,
+    options: ContinuationOptions | None = None,
+    callback: StepCallback | None = None,
+    t_start: float = 0.0,
+) -> StaticResult:
+    """Follow the load path from ``t_start`` to 1.
+
+    ``callback(system, record)`` runs after each converged step; returning a string stops
+    the run as failed with that reason (e.g. a topology check that found the knot changed).
+    """
+    opt = options or ContinuationOptions()
+    start = time.perf_counter()
+    t = float(t_start)
+    dt = min(opt.max_step, (1.0 - t) / opt.steps) if t < 1.0 else 0.0
+    records: list[StepRecord] = []
+    total_iters = 0
+    if t >= 1.0 or dt == 0.0:
+        system.set_load(1.0)
+        res = newton_solve(system, system.free_vector(), opt.newton)
+        rec = StepRecord(1.0, res)
+        total_iters += res.iterations
+        if res.converged:
+            records.append(rec)
+        return StaticResult(res.converged, 1.0, records, total_iters,
+                            "" if res.converged else f"Newton {res.reason} at t=1",
+                            time.perf_counter() - start)
+    while t < 1.0 - 1e-14:
+        t_next = min(1.0, t + dt)
+        saved = system.state.copy()
+        system.set_load(t_next)
+        res = newton_solve(system, system.free_vector(), opt.newton)
+        total_iters += res.iterations
+        if not res.converged:
+            system.state = saved
+            system.set_load(t)
+            dt *= 0.5
+            if dt < opt.min_step:
+                return StaticResult(
+                    False, t, records, total_iters,
+                    f"Newton {res.reason} (residual {res.residual:.3g}) at load t={t_next:.6g};"
+                    f" step halved below min_step={opt.min_step:g}",
+                    time.perf_counter() - start)
+            continue
+        rec = StepRecord(t_next, res)
+        records.append(rec)
+        t = t_next
+        if callback is not None:
+            reason = callback(system, rec)
+            if reason:
+                return StaticResult(False, t, records, total_iters, reason,
+                                    time.perf_counter() - start)
+        if res.iterations < opt.grow_below:
+            dt = min(opt.max_step, dt * 2.0)
+    return StaticResult(True, 1.0, records, total_iters, "", time.perf_counter() - start)

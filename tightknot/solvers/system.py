@@ -1,0 +1,259 @@
+"""The total potential of a rod model as a function of its free degrees of freedom.
+
+``Pi(q) = E_elastic(q) + sum_k E_k(q) - f_ext . x + Phi_inertia(q)``, where the ``E_k`` are
+extra terms (the contact layer) and the inertia term is present only in implicit dynamics:
+``Phi_inertia = sum m/(2 h^2) |q - q_hat|^2`` (implicit Euler as a minimisation, e.g.
+Kane et al. 2000; Martin et al. 2011 "Example-based elastic materials"). Quasi-static and
+dynamic solves therefore share one Newton loop and differ only by that term.
+
+Reference frames are carried from the last accepted state by time-parallel transport
+(Bergou 2010 sec. 4.1); trial evaluations never modify the state until :meth:`accept`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+import scipy.sparse as sp
+import warp as wp
+
+from tightknot.rods.boundary import BoundaryConditions
+from tightknot.rods.elastic import ElasticForces
+from tightknot.rods.model import Model
+from tightknot.rods.state import State
+from tightknot.solvers.linear import SparsePattern
+
+
+class ExtraTerm(Protocol):
+    """An energy term added to the elastic rods (e.g. the contact layer)."""
+
+    name: str
+
+    def evaluate(
+        self, x: np.ndarray, want_grad: bool, want_hess: bool
+    ) -> tuple[float, np.ndarray | None, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
+        """Energy [J], gradient over position dofs (vertex_count, 3) [N], and Hessian COO
+        triplets over global dofs (rows, cols, values)."""
+        ...
+
+    def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
+        """Largest fraction in (0, 1] of the step ``dx`` that keeps the term valid."""
+        ...
+
+
+@dataclass
+class Inertia:
+    """Implicit-Euler inertia term: time step ``dt`` [s] and predicted dofs ``q_hat``."""
+
+    dt: float
+    q_hat: np.ndarray
+    mass: np.ndarray  # per dof: vertex mass [kg] or twist inertia [kg m^2]
+
+
+@dataclass
+class EnergySplit:
+    """Energy split of the last evaluation [J]."""
+
+    stretch: float = 0.0
+    bend: float = 0.0
+    twist: float = 0.0
+    external: float = 0.0
+    inertia: float = 0.0
+    extra: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def magnitude(self) -> float:
+        """Sum of the absolute values of the parts [J]: the scale of the total's round-off."""
+        return (abs(self.stretch) + abs(self.bend) + abs(self.twist) + abs(self.external)
+                + abs(self.inertia) + sum(abs(v) for v in self.extra.values()))
+
+    @property
+    def total(self) -> float:
+        """Total potential [J]."""
+        return (self.stretch + self.bend + self.twist + self.external + self.inertia
+                + sum(self.extra.values()))
+
+
+class RodSystem:
+    """Energy, gradient and Hessian of a model under boundary conditions at load parameter t.
+
+    Args:
+        model: the rods.
+        state: their state; the solver writes accepted iterates into it.
+        bcs: boundary conditions and loads (default: none).
+        gravity: gravitational acceleration vector [m/s^2] or None (the study's scenes
+            neglect gravity; physics.md sec. 1).
+    """
+
+    def __init__(
+        self,
+        model: Model,
+        state: State,
+        bcs: BoundaryConditions | None = None,
+        gravity: np.ndarray | None = None,
+    ) -> None:
+        self.model = model
+        self.state = state
+        self.bcs = bcs if bcs is not None else BoundaryConditions(model)
+        self.gravity = None if gravity is None else np.asarray(gravity, dtype=np.float64)
+        self.extra_terms: list[ExtraTerm] = []
+        self.inertia: Inertia | None = None
+        self.pattern = SparsePattern(model, ~self.bcs.fixed_mask())
+        self.forces = ElasticForces(model, self.pattern.joint_slot, self.pattern.edge_slot)
+        self._hess = wp.zeros(max(self.pattern.nnz, 1), dtype=wp.float64, device=model.device)
+        self.bcs.capture(state.d1_ref, state.t_ref, state.theta)
+        free = self.pattern.free_dofs
+        is_theta = np.zeros(model.dof_count, dtype=bool)
+        if model.twist:
+            is_theta[model.edge_dof] = True
+        self.free_is_theta = is_theta[free]
+        self.dof_mass = np.zeros(model.dof_count)
+        self.dof_mass[model.position_dofs] = model.vertex_mass[:, None]
+        if model.twist:
+            self.dof_mass[model.edge_dof] = model.edge_rot_inertia
+        # Scales of the convergence tests: a bending force and moment of the stiffest rod
+        # over its own length, EI/L^2 [N] and EI/L [N m], and the smallest rest radius [m].
+        ei = model.joint_bend_stiffness.max() if model.joint_count else 1.0
+        lmax = max(model.rest_length(r) for r in range(len(model.rods)))
+        self.force_scale = float(ei / lmax**2)
+        self.moment_scale = float(ei / lmax)
+        self.length_scale = float(model.edge_radius.min())
+        self.t = 0.0
+        self.last_split = EnergySplit()
+        self._trial: tuple[np.ndarray, ...] | None = None
+        self.set_load(0.0)
+
+    # -- load path -------------------------------------------------------------------
+    def set_load(self, t: float) -> None:
+        """Move to load parameter t: rest lengths, dead loads and prescribed dofs."""
+        self.t = float(t)
+        self.rest = self.bcs.edge_rest_length(self.t)
+        f = self.bcs.external_force(self.t)
+        if self.gravity is not None:
+            f = f + self.model.vertex_mass[:, None] * self.gravity[None, :]
+        self.f_ext = f
+        st = self.state
+        # External work is measured from the positions at this load step, so that its
+        # round-off stays that of the displacements, not of the coordinates.
+        self._x_ref = st.x.copy()
+        x = st.x.copy()
+        self.bcs.prescribe_positions(self.t, x)
+        d1, tt, mref = self.forces.transport_frames(x, st.d1_ref, st.t_ref, st.m_ref)
+        st.x, st.d1_ref, st.t_ref, st.m_ref = x, d1, tt, mref
+        self.bcs.prescribe_twist(self.t, st.theta, st.d1_ref, st.t_ref)
+        self._trial = None
+
+    # -- dof vectors -----------------------------------------------------------------
+    def full_dofs(self) -> np.ndarray:
+        """The state's dof vector (all dofs)."""
+        return self.state.dofs(self.model)
+
+    def free_vector(self) -> np.ndarray:
+        """The state's free dofs."""
+        return self.full_dofs()[self.pattern.free_dofs]
+
+    def _split(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        q = self.full_dofs()
+        q[self.pattern.free_dofs] = u
+        x = q[self.model.position_dofs]
+        theta = q[self.model.edge_dof] if self.model.twist else self.state.theta
+        return x, theta
+
+    def positions(self, u: np.ndarray) -> np.ndarray:
+        """Vertex positions [m] of free-dof vector ``u``."""
+        return self._split(u)[0]
+
+    # -- evaluation ------------------------------------------------------------------
+    def evaluate(
+        self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True
+    ) -> tuple[float, np.ndarray | None, sp.csc_matrix | None]:
+        """Total potential [J], its gradient on the free dofs, and the free-dof Hessian."""
+        m, st = self.model, self.state
+        x, theta = self._split(u)
+        d1, tt, mref = self.forces.transport_frames(x, st.d1_ref, st.t_ref, st.m_ref)
+        self._trial = (u.copy(), x, theta, d1, tt, mref)
+        if want_hess:
+            self._hess.zero_()
+        el, grad = self.forces.evaluate(x, theta, mref, self.rest, want_grad or want_hess,
+                                        self._hess if want_hess else None)
+        split = EnergySplit(stretch=el.stretch, bend=el.bend, twist=el.twist)
+        split.external = -float(np.sum(self.f_ext * (x - self._x_ref)))
+        coo_parts = []
+        if grad is not None:
+            grad[m.position_dofs] -= self.f_ext
+        for term in self.extra_terms:
+            e_k, g_k, h_k = term.evaluate(x, want_grad or want_hess, want_hess)
+            split.extra[term.name] = e_k
+            if grad is not None and g_k is not None:
+                grad[m.position_dofs] += g_k
+            if want_hess and h_k is not None:
+                coo_parts.append(h_k)
+        if self.inertia is not None:
+            q = self.full_dofs()
+            q[self.pattern.free_dofs] = u
+            dq = q - self.inertia.q_hat
+            w = self.inertia.mass / self.inertia.dt**2
+            split.inertia = 0.5 * float(np.sum(w * dq * dq))
+            if grad is not None:
+                grad += w * dq
+        self.last_split = split
+        g_free = grad[self.pattern.free_dofs] if grad is not None else None
+        hmat = None
+        if want_hess:
+            data = self._hess.numpy()[: self.pattern.nnz].copy()
+            if self.inertia is not None:
+                w = self.inertia.mass / self.inertia.dt**2
+                data[self.pattern.diag_slot] += w[self.pattern.free_dofs]
+            hmat = self.pattern.matrix(data)
+            if coo_parts:
+                hmat = hmat + self._coo_free(coo_parts)
+        return split.total, g_free, hmat
+
+    def _coo_free(self, parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> sp.csc_matrix:
+        fi = self.pattern.free_index
+        rows = np.concatenate([p[0] for p in parts])
+        cols = np.concatenate([p[1] for p in parts])
+        vals = np.concatenate([p[2] for p in parts])
+        r, c = fi[rows], fi[cols]
+        keep = (r >= 0) & (c >= 0)
+        n = self.pattern.n
+        return sp.csc_matrix((vals[keep], (r[keep], c[keep])), shape=(n, n))
+
+    def max_step(self, u: np.ndarray, du: np.ndarray) -> float:
+        """Largest step fraction allowed by the extra terms (e.g. no passing through)."""
+        if not self.extra_terms:
+            return 1.0
+        x0 = self.positions(u)
+        dx = self.positions(u + du) - x0
+        return min(term.max_step(x0, dx) for term in self.extra_terms)
+
+    def accept(self, u: np.ndarray) -> None:
+        """Make ``u`` the state (positions, twist, transported frames)."""
+        if self._trial is None or not np.array_equal(self._trial[0], u):
+            self.evaluate(u, want_grad=False, want_hess=False)
+        _, x, theta, d1, tt, mref = self._trial
+        st = self.state
+        st.x, st.d1_ref, st.t_ref, st.m_ref = x.copy(), d1, tt, mref
+        if self.model.twist:
+            st.theta = theta.copy()
+
+    def energy_roundoff(self) -> float:
+        """An upper estimate of the round-off of the last total potential [J]."""
+        return 1e-13 * self.last_split.magnitude
+
+    # -- norms -------------------------------------------------------------------------
+    def residual_norm(self, g: np.ndarray) -> float:
+        """Max-norm of the free-dof gradient, forces over EI/L^2 and moments over EI/L [-]."""
+        if g.size == 0:
+            return 0.0
+        scale = np.where(self.free_is_theta, self.moment_scale, self.force_scale)
+        return float(np.max(np.abs(g) / scale))
+
+    def step_norm(self, du: np.ndarray) -> float:
+        """Max-norm of a step, displacements over the smallest radius, angles in rad [-]."""
+        if du.size == 0:
+            return 0.0
+        scale = np.where(self.free_is_theta, 1.0, self.length_scale)
+        return float(np.max(np.abs(du) / scale))
