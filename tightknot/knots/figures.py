@@ -1,0 +1,142 @@
+"""Figures of knot measurements (matplotlib Agg, PNG at 150 dpi, written atomically).
+
+Every function takes the dicts returned by :func:`tightknot.knots.measure.analyze_centerline`
+(plus optional per-vertex arrays) and writes one PNG. Axes carry the non-dimensional names of
+Johanns et al. 2021 (s, sigma, rho, z, kappa D0, L_c, A/A0). Colours are fixed: elastic or
+measured knots in blue/orange, the ideal knot in black dashes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only; never needs a display
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+DPI = 150
+COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728")
+IDEAL_STYLE = {"color": "black", "linestyle": "--", "linewidth": 1.0, "label": "ideal"}
+
+
+def save_png_atomic(fig: Any, path: str | os.PathLike[str]) -> None:
+    """Save ``fig`` as PNG to a temporary name beside ``path``, then rename (atomic)."""
+    target = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, format="png", dpi=DPI, bbox_inches="tight")
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+    finally:
+        plt.close(fig)
+
+
+def _closed_kappa(rep: Mapping[str, Any]) -> np.ndarray:
+    return np.asarray(rep["kappa_D0_sorted"])
+
+
+def plot_closed_profiles(
+    report: Mapping[str, Any], path: str | os.PathLike[str],
+    ideal: Mapping[str, Any] | None = None, label: str = "knot",
+) -> None:
+    """rho(s), z(s), kappa D0 (s) of a closed knot, the ideal knot overlaid if given."""
+    fig, axes = plt.subplots(3, 1, figsize=(7, 8), sharex=True)
+    series = [("rho", r"$\rho = \sqrt{X^2+Y^2}/D_0$"), ("z", r"$z = Z/D_0$"),
+              ("kappa", r"$\kappa D_0$")]
+    for ax, (key, name) in zip(axes, series, strict=True):
+        for rep, style in ((report, {"color": COLORS[0], "label": label}), (ideal, IDEAL_STYLE)):
+            if rep is None:
+                continue
+            y = _closed_kappa(rep) if key == "kappa" else np.asarray(rep[key])
+            ax.plot(rep["s"], y, **style)
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+        for s_in in report.get("inner_segments_s", []):
+            ax.axvline(s_in, color="0.8", linewidth=0.8, zorder=0)
+    axes[2].axhline(2.0, color="0.5", linewidth=0.8, linestyle=":")
+    axes[2].text(axes[2].get_xlim()[0], 2.0, " active limit 2", va="bottom", color="0.4")
+    axes[0].legend(loc="upper right")
+    axes[0].set_title("closed trefoil (grey lines: inner segments)")
+    axes[2].set_xlabel(r"$s = S/L \cdot L_0/D_0$")
+    save_png_atomic(fig, path)
+
+
+def plot_contact_map(
+    report: Mapping[str, Any], path: str | os.PathLike[str],
+    ideal: Mapping[str, Any] | None = None, label: str = "knot",
+) -> None:
+    """Contact map (s, sigma); the ideal knot's double-contact set overlaid if given.
+
+    For the ideal knot pass a report made with a tight ``contact_tol`` (e.g. 0.002): its
+    contact set is then the double-contact lines.
+    """
+    fig, ax = plt.subplots(figsize=(6, 6))
+    ax.scatter(report["contact_s"], report["contact_sigma"], s=1, color=COLORS[0],
+               label=label, rasterized=True)
+    if ideal is not None:
+        ax.scatter(ideal["contact_s"], ideal["contact_sigma"], s=0.3, color="black",
+                   label="ideal (double contact)", rasterized=True)
+    ax.plot([min(report["s"]), max(report["s"])], [min(report["s"]), max(report["s"])],
+            color="0.7", linewidth=0.8)
+    ax.set_xlabel(r"$s$")
+    ax.set_ylabel(r"$\sigma$")
+    ax.set_aspect("equal")
+    ax.set_title("contact map")
+    ax.legend(loc="upper left", markerscale=8)
+    save_png_atomic(fig, path)
+
+
+def plot_open_knots(
+    reports: Mapping[str, Mapping[str, Any]],
+    path: str | os.PathLike[str],
+    contact_width: Mapping[str, Sequence[float]] | None = None,
+    area_ratio: Mapping[str, Sequence[float]] | None = None,
+) -> None:
+    """Open knots at several tightness levels: kappa D0 (s), contact maps, L_c(s), A(s)/A0.
+
+    ``reports``: label -> analyze_centerline dict of an open knot (e.g. "Lambda_OC = 15.0").
+    ``contact_width``/``area_ratio``: label -> per-vertex arrays (from the contact layer),
+    plotted against that report's s.
+    """
+    extra = [(d, n) for d, n in ((contact_width, r"$L_c$ (contact width)"),
+                                  (area_ratio, r"$A/A_0$")) if d]
+    ncol = max(len(reports), 1)
+    fig = plt.figure(figsize=(5 * max(ncol, 2), 4 + 2.5 * (1 + len(extra))))
+    grid = fig.add_gridspec(2 + len(extra), ncol, height_ratios=[1, 1.6] + [1] * len(extra))
+    ax_k = fig.add_subplot(grid[0, :])
+    extra_axes = [fig.add_subplot(grid[2 + row, :], sharex=ax_k) for row in range(len(extra))]
+    for k, (lab, rep) in enumerate(reports.items()):
+        c = COLORS[k % len(COLORS)]
+        lam = rep.get("Lambda_OC")
+        name = lab if lam is None else f"{lab} ($\\Lambda_{{OC}}$ = {lam:.1f})"
+        ax_k.plot(rep["s"], rep["kappa_D0"], color=c, label=name)
+        ax_m = fig.add_subplot(grid[1, k])
+        ax_m.scatter(rep["contact_s"], rep["contact_sigma"], s=1, color=c, rasterized=True)
+        ax_m.set_xlabel(r"$s$")
+        ax_m.set_ylabel(r"$\sigma$")
+        ax_m.set_aspect("equal")
+        ax_m.set_title(f"contact map: {lab}")
+        for ax, (data, _) in zip(extra_axes, extra, strict=True):
+            if lab in data:
+                ax.plot(rep["s"], data[lab], color=c, label=lab)
+    for ax, (_, ylab) in zip(extra_axes, extra, strict=True):
+        ax.set_ylabel(ylab)
+        ax.set_xlabel(r"$s = (S - S_{mid})/D_0$")
+        ax.grid(alpha=0.3)
+    ax_k.set_xlabel(r"$s = (S - S_{mid})/D_0$")
+    ax_k.set_ylabel(r"$\kappa D_0$")
+    ax_k.grid(alpha=0.3)
+    ax_k.legend()
+    fig.tight_layout()
+    save_png_atomic(fig, path)
