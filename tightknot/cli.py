@@ -1,9 +1,192 @@
-"""Command-line interface (placeholder until subcommands land)."""
+"""The ``tightknot`` command line.
 
+Exit codes: 0 success, 1 the physics failed (no convergence, a failed verification,
+a topology change) with the reason printed, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
 import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from tightknot import __version__
+
+EXIT_OK, EXIT_PHYSICS, EXIT_BAD_INPUT = 0, 1, 2
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``tightknot`` console script."""
-    print("tightknot: no subcommands yet", file=sys.stderr)
-    return 2
+class _Parser(argparse.ArgumentParser):
+    """argparse with exit code 2 and a one-line message on bad arguments."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        raise SystemExit(EXIT_BAD_INPUT)
+
+
+def _writable_file(path: str | None) -> Path | None:
+    """Check before the run that an output file's folder exists (issue: fail early)."""
+    if path is None:
+        return None
+    p = Path(path)
+    if not p.parent.exists() and str(p.parent) not in ("", "."):
+        raise ValueError(f"output folder does not exist: {p.parent}")
+    if p.is_dir():
+        raise ValueError(f"output path is a folder, not a file: {p}")
+    return p
+
+
+# -- verify ----------------------------------------------------------------------------------
+_VERIFY_EXAMPLES = """examples:
+  tightknot verify
+  tightknot verify --case euler_buckling --case michell_instability
+  tightknot verify --json verify.json
+"""
+
+
+def _cmd_verify(args: argparse.Namespace) -> int:
+    from tightknot.atomic import write_json_atomic
+    from tightknot.verification import CASES, run_all
+    from tightknot.warp_setup import resolve_device
+
+    out = _writable_file(args.json)
+    device = resolve_device(args.device)
+    unknown = [c for c in (args.case or []) if c not in CASES]
+    if unknown:
+        raise ValueError(f"unknown --case {unknown}; valid: {', '.join(CASES)}")
+    rows = run_all(device, args.case)
+    head = (f"{'case':44s} {'reference':>13s} {'computed':>13s} {'rel_error':>10s} "
+            f"{'order':>6s}  ok")
+    if not args.quiet:
+        print(head)
+        print("-" * len(head))
+        for r in rows:
+            order = "" if r.order is None else f"{r.order:.2f}"
+            print(f"{r.case:44s} {r.reference:13.6g} {r.computed:13.6g} {r.rel_error:10.2e} "
+                  f"{order:>6s}  {'yes' if r.passed else 'NO'}")
+    if out is not None:
+        write_json_atomic(out, [r.as_dict() for r in rows])
+    failed = [r.case for r in rows if not r.passed]
+    if failed:
+        print(f"verification failed: {', '.join(failed)}", file=sys.stderr)
+        return EXIT_PHYSICS
+    return EXIT_OK
+
+
+# -- bench -----------------------------------------------------------------------------------
+_BENCH_EXAMPLES = """examples:
+  tightknot bench der --json der.json
+  tightknot bench der --sizes 100 1000 --no-startup
+"""
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from tightknot.atomic import write_json_atomic
+    from tightknot.benchmarks import der
+    from tightknot.warp_setup import resolve_device
+
+    out = _writable_file(args.json)
+    device = resolve_device(args.device)
+    if args.which != "der":
+        raise ValueError(f"unknown benchmark {args.which!r}; valid: der")
+    sizes = tuple(args.sizes) if args.sizes else der.DEFAULT_SIZES
+    if any(n < 3 for n in sizes):
+        raise ValueError("--sizes must be >= 3 vertices each")
+    result = der.run(sizes, startup=not args.no_startup, device=device)
+    for r in result["rows"]:
+        print(f"{r['vertices']:>8d} vertices: iteration {r['newton_iteration_s'] * 1e3:9.3f} ms"
+              f"  (assembly {r['assembly_s'] * 1e3:8.3f} ms, solve {r['solve_s'] * 1e3:8.3f} ms)")
+    for key in ("ratio_1e5_over_1e3", "startup_cold_cache_s", "startup_warm_cache_s"):
+        if key in result:
+            print(f"{key}: {result[key]:.3f}")
+    if out is not None:
+        write_json_atomic(out, result)
+    return EXIT_OK
+
+
+# -- demo ------------------------------------------------------------------------------------
+_DEMO_EXAMPLES = """examples:
+  tightknot demo                 # writes runs/demo/
+  tightknot demo --out /tmp/tk
+"""
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from tightknot.demo import run_demo
+
+    out = Path(args.out)
+    summary = run_demo(out, quiet=args.quiet)
+    if not args.quiet:
+        print(json.dumps({k: v for k, v in summary.items() if not isinstance(v, list)},
+                         indent=2))
+        print(f"wrote {out}/ (summary.json, figures, demo.rrd)")
+    return EXIT_OK if summary.get("passed", False) else EXIT_PHYSICS
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every subcommand."""
+    parser = _Parser(
+        prog="tightknot",
+        description="Tight physical knots in elastic rods: discrete elastic rods in Warp.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"tightknot {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser("verify", help="run the verification cases against closed-form mechanics",
+                       description="Run the DER verification cases (cantilevers, buckling, "
+                       "rings, Michell, neo-Hookean stretch, implicit Euler) and print a table.",
+                       epilog=_VERIFY_EXAMPLES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--case", action="append", help="run only this case (repeatable)")
+    p.add_argument("--json", metavar="FILE", help="write the rows as JSON")
+    p.add_argument("--device", default=None, help="Warp device (default cpu)")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.set_defaults(handler=_cmd_verify)
+
+    p = sub.add_parser("bench", help="benchmarks (der: Newton-iteration cost vs size)",
+                       description="Benchmarks; results print and go to --json FILE.",
+                       epilog=_BENCH_EXAMPLES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("which", choices=["der"], help="which benchmark")
+    p.add_argument("--json", metavar="FILE", help="write the result as JSON")
+    p.add_argument("--sizes", type=int, nargs="+", help="vertex counts (default 1e2..1e5)")
+    p.add_argument("--no-startup", action="store_true", help="skip the start-up timing")
+    p.add_argument("--device", default=None, help="Warp device (default cpu)")
+    p.set_defaults(handler=_cmd_bench)
+
+    p = sub.add_parser("demo", help="run the demo scene: figures, JSON and an .rrd",
+                       description="Run the embedded demo and write its outputs to --out.",
+                       epilog=_DEMO_EXAMPLES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", default="runs/demo", help="output folder (created)")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.set_defaults(handler=_cmd_demo)
+
+    try:
+        from tightknot.fem.commands import register as register_fem
+    except ImportError:  # pragma: no cover - the fem package itself always imports
+        register_fem = None
+    if register_fem is not None:
+        register_fem(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``tightknot`` console script; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if getattr(args, "handler", None) is None:
+        parser.print_help()
+        return EXIT_BAD_INPUT
+    try:
+        return int(args.handler(args))
+    except ValueError as err:
+        print(f"tightknot {args.command}: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+if __name__ == "__main__":
+    sys.exit(main())

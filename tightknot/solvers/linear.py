@@ -76,23 +76,43 @@ class SparsePattern:
 
 
 class Factorization:
-    """Sparse LU of a symmetric matrix (SuperLU), with ``solve(b)``."""
+    """Sparse LU of a symmetric matrix (SuperLU), with ``solve(b)``.
+
+    The matrix is first equilibrated symmetrically, ``S A S`` with ``S = |diag A|^-1/2``:
+    positions and twist angles have stiffnesses many decades apart (EA/l against GJ/l),
+    and SuperLU without pivoting lost digits (measured on a 1e5-vertex helix: relative
+    residual 5e-5 with ``diag_pivot_thresh=0``; 1e-9 with the threshold 0.1 used here, at
+    the same speed). A banded matrix (an open rod without contact) keeps its natural order,
+    which is already optimal (0.38 s against 0.57 s for minimum degree at 1e5 vertices);
+    otherwise the ordering is minimum degree on A^T + A.
+    """
+
+    #: Largest |row - col| for which the natural order is kept.
+    BANDED_LIMIT = 64
 
     def __init__(self, a: sp.csc_matrix) -> None:
-        # A symmetric pattern: ordering on A^T + A, diagonal pivots first (the scout of the
-        # FEM issue measured this 2-3x faster than the defaults on symmetric matrices).
-        self._lu = spla.splu(
-            a,
-            permc_spec="MMD_AT_PLUS_A",
-            diag_pivot_thresh=0.0,
-            options=dict(SymmetricMode=True),
-        )
+        a = sp.csc_matrix(a)
+        a.sum_duplicates()
+        d = np.abs(a.diagonal())
+        d = np.where(d > 0.0, d, 1.0)
+        self._s = 1.0 / np.sqrt(d)
+        cols = np.repeat(np.arange(a.shape[1]), np.diff(a.indptr))
+        rows = a.indices
+        sa = sp.csc_matrix((a.data * self._s[rows] * self._s[cols], rows, a.indptr),
+                           shape=a.shape)
+        bandwidth = int(np.abs(rows - cols).max()) if a.nnz else 0
+        spec = "NATURAL" if bandwidth <= self.BANDED_LIMIT else "MMD_AT_PLUS_A"
+        # Prefer diagonal pivots with a symmetric pattern (the FEM scout measured this 2-3x
+        # faster than the defaults on symmetric matrices), but pivot when a diagonal entry is
+        # below 0.1 of its column's largest.
+        self._lu = spla.splu(sa, permc_spec=spec, diag_pivot_thresh=0.1,
+                             options=dict(SymmetricMode=True))
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solve A x = b."""
-        return self._lu.solve(b)
+        return self._s * self._lu.solve(self._s * b)
 
 
 def factorize(a: sp.spmatrix) -> Factorization:
     """Factorize ``a``; raises RuntimeError when it is exactly singular."""
-    return Factorization(sp.csc_matrix(a))
+    return Factorization(a)

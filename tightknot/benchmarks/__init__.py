@@ -1,0 +1,1 @@
+"""Benchmarks behind ``tightknot bench`` and the scripts in ``bench/``."""

@@ -1,0 +1,95 @@
+"""Cost of one Newton iteration of the DER core (assembly plus sparse direct solve).
+
+A clamped helix with a tip load (every stencil bent, stretched and twisted) of N vertices;
+one iteration = Warp evaluation of energy, gradient and Hessian, plus the factorization
+and solve. Also the start-up: Warp kernel compilation with an empty cache and with a warm
+one, each measured in a fresh subprocess.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from tightknot.rods.boundary import BoundaryConditions
+from tightknot.rods.builder import RodBuilder
+from tightknot.rods.material import Material
+from tightknot.rods.state import State
+from tightknot.solvers.linear import factorize
+from tightknot.solvers.system import RodSystem
+
+DEFAULT_SIZES = (100, 1000, 10000, 100000)
+
+
+def helix(n: int, turns_per_vertex: float = 0.01, radius: float = 0.02,
+          pitch: float = 0.01) -> np.ndarray:
+    """A helix of n vertices [m] (0.01 turn per edge: every joint bent)."""
+    phi = 2 * np.pi * turns_per_vertex * np.arange(n)
+    return np.c_[radius * np.cos(phi), radius * np.sin(phi), pitch * phi / (2 * np.pi)]
+
+
+def iteration_time(n: int, repeats: int = 5, device: str = "cpu") -> dict:
+    """Median times [s] of assembly, solve and one whole Newton iteration for n vertices."""
+    b = RodBuilder()
+    b.add_rod(helix(n), diameter=0.002, material=Material())
+    model = b.finalize(device)
+    bcs = BoundaryConditions(model).clamp(0, "start").force(0, -1, [0.0, 0.0, -1e-3])
+    system = RodSystem(model, State.initial(model), bcs)
+    system.set_load(1.0)
+    u = system.free_vector()
+    system.evaluate(u)  # warm-up (kernel load, allocations)
+    ta, ts = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        _, g, h = system.evaluate(u, True, True)
+        t1 = time.perf_counter()
+        factorize(h).solve(-g)
+        t2 = time.perf_counter()
+        ta.append(t1 - t0)
+        ts.append(t2 - t1)
+    a, s = float(np.median(ta)), float(np.median(ts))
+    return {"vertices": n, "newton_iteration_s": a + s, "assembly_s": a, "solve_s": s}
+
+
+_STARTUP = (
+    "import time; t=time.perf_counter();"
+    "from tightknot.verification.cases import neo_hookean_stretch;"
+    "neo_hookean_stretch(); print(time.perf_counter()-t)"
+)
+
+
+def startup_time(cache_dir: str | None) -> float:
+    """Seconds to import tightknot, load (or compile) its kernels and solve a tiny case,
+    in a fresh Python process; ``cache_dir`` is the Warp kernel cache to use."""
+    env = dict(os.environ)
+    if cache_dir is not None:
+        env["WARP_CACHE_PATH"] = cache_dir
+    out = subprocess.run([sys.executable, "-c", _STARTUP], env=env, check=True,
+                         capture_output=True, text=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
+def run(sizes: tuple[int, ...] = DEFAULT_SIZES, startup: bool = True,
+        device: str = "cpu") -> dict:
+    """All rows, the scaling ratio and (optionally) cold/warm start-up times."""
+    rows = [iteration_time(n, device=device) for n in sizes]
+    result: dict = {"rows": rows}
+    by_n = {r["vertices"]: r["newton_iteration_s"] for r in rows}
+    if 1000 in by_n and 100000 in by_n:
+        result["ratio_1e5_over_1e3"] = by_n[100000] / by_n[1000]
+    if startup:
+        with tempfile.TemporaryDirectory() as cold:
+            result["startup_cold_cache_s"] = startup_time(cold)
+            result["startup_warm_cache_s"] = startup_time(cold)
+    result["targets"] = {
+        "ratio_1e5_over_1e3_max": 150.0,
+        "newton_iteration_1e3_max_s": 5e-3,
+        "startup_cold_cache_max_s": 30.0,
+        "startup_warm_cache_max_s": 1.0,
+    }
+    return result
