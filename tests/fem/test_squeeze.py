@@ -48,7 +48,7 @@ def test_incompressibility(squeeze_plane_strain_convergence):
 def test_force_grows_with_approach(squeeze_plane_strain_convergence):
     steps = squeeze_plane_strain_convergence["steps"]
     forces = [s["force_per_length"] for s in steps]
-    assert all(b > a for a, b in zip(forces, forces[1:]))
+    assert all(b > a for a, b in zip(forces, forces[1:], strict=False))
     assert steps[-1]["approach_over_d0"] == pytest.approx(0.3)
 
 
@@ -83,6 +83,6 @@ def test_3d_plane_ends_reproduce_plane_strain():
     a = run_scene("squeeze", mesh="coarse", steps=4, model="3d", ends="plane",
                   convergence=False)
     b = run_scene("squeeze", mesh="coarse", steps=4, model="plane_strain", convergence=False)
-    for sa, sb in zip(a["steps"], b["steps"]):
+    for sa, sb in zip(a["steps"], b["steps"], strict=True):
         assert sa["force_per_length"] == pytest.approx(sb["force_per_length"], rel=1e-5)
         assert sa["half_width_over_d0"] == pytest.approx(sb["half_width_over_d0"], rel=1e-5)

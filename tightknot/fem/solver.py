@@ -130,6 +130,8 @@ class Problem:
                     self.solid.restore(checkpoint)
                     cutbacks += 1
                     if cutbacks > max_cutbacks:
-                        raise NewtonFailure(f"increment to load {target:.4g} failed: {err}")
+                        raise NewtonFailure(
+                            f"increment to load {target:.4g} failed: {err}"
+                        ) from err
             results.append(measure(target))
         return results

@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from .._backend import require_felupe
 from .. import hertz
+from .._backend import require_felupe
 from ..contact import PenaltyContact, RigidPlane
 from ..material import (
     BULK_MODULUS,
