@@ -59,7 +59,12 @@ class RodBuilder:
             link_offset: closed rods only: excess link in whole turns added to the
                 reference twist of the closing joint (0 = frame joined with no excess twist).
         """
-        pts = np.asarray(positions, dtype=np.float64)
+        try:
+            if np.iscomplexobj(positions):
+                raise TypeError("complex")
+            pts = np.asarray(positions, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError("positions must be a real (N, 3) array of numbers [m]") from None
         if pts.ndim != 2 or pts.shape[1] != 3:
             raise ValueError(f"positions must have shape (N, 3), got {pts.shape}")
         n = pts.shape[0]
@@ -71,12 +76,21 @@ class RodBuilder:
                 f"positions must be finite; vertex {int(np.argmax(bad))} is {pts[bad][0]}"
             )
         d0 = check_positive("diameter", diameter, "m")
+        with np.errstate(over="ignore"):
+            sizes_ok = np.isfinite([section_area(d0), second_moment(d0)]).all() if d0 < 1e75 \
+                else False
+        if not sizes_ok:
+            raise ValueError(f"diameter must be > 0 m and small enough for D^4 to be finite, "
+                             f"got {diameter!r}")
         mat = material if material is not None else Material()
         if not isinstance(mat, Material):
             raise ValueError(f"material must be a tightknot.rods.Material, got {type(mat)}")
         closed = bool(closed)
-        edges = np.diff(np.vstack([pts, pts[:1]]) if closed else pts, axis=0)
-        lengths = np.linalg.norm(edges, axis=1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            edges = np.diff(np.vstack([pts, pts[:1]]) if closed else pts, axis=0)
+            lengths = np.linalg.norm(edges, axis=1)
+        if not np.isfinite(lengths).all():
+            raise ValueError("positions are too large: edge lengths overflow float64")
         mean = lengths.mean()
         short = lengths <= _COINCIDENT_FRACTION * mean
         if mean <= 0.0 or short.any():
@@ -96,15 +110,23 @@ class RodBuilder:
                 raise ValueError("edge_rest_lengths must be finite and > 0 m")
         elif rest_length is not None:
             l0 = check_positive("rest_length", rest_length, "m")
-            rest = lengths * (l0 / lengths.sum())
+            with np.errstate(over="ignore"):
+                rest = lengths * (l0 / lengths.sum())
+            if not (np.isfinite(rest).all() and (rest > 0).all()):
+                raise ValueError(f"rest_length {rest_length!r} m gives edge rest lengths that "
+                                 "are not finite and > 0 for these positions")
         else:
             rest = lengths.copy()
-        if link_offset and not closed:
+        try:
+            lo = float(link_offset)
+        except (TypeError, ValueError):
+            lo = math.nan
+        if not math.isfinite(lo) or lo != round(lo):
+            raise ValueError(f"link_offset must be a whole number of turns, got {link_offset!r}")
+        if lo and not closed:
             raise ValueError("link_offset applies to closed rods only")
-        if int(link_offset) != link_offset:
-            raise ValueError(f"link_offset must be a whole number of turns, got {link_offset}")
         self._rods.append(
-            dict(pts=pts, d0=d0, mat=mat, closed=closed, rest=rest, link=int(link_offset))
+            dict(pts=pts, d0=d0, mat=mat, closed=closed, rest=rest, link=int(lo))
         )
         return len(self._rods) - 1
 

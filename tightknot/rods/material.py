@@ -31,10 +31,10 @@ class Material:
 
     def __post_init__(self) -> None:
         check_positive("youngs_modulus", self.youngs_modulus, "Pa")
-        nu = float(self.poisson_ratio)
+        nu = _as_float("poisson_ratio", self.poisson_ratio, "in (-1, 0.5]")
         if not math.isfinite(nu) or not (-1.0 < nu <= 0.5):
             raise ValueError(f"poisson_ratio must be in (-1, 0.5], got {self.poisson_ratio!r}")
-        rho = float(self.density)
+        rho = _as_float("density", self.density, ">= 0 kg/m^3")
         if not math.isfinite(rho) or rho < 0.0:
             raise ValueError(f"density must be a finite value >= 0 kg/m^3, got {self.density!r}")
 
@@ -56,6 +56,14 @@ class Material:
         adds one more power of lambda (see ``tightknot.rods.elastic_kernels``).
         """
         return 4.0 * self.poisson_ratio + 1.0
+
+
+def _as_float(name: str, value: object, valid: str) -> float:
+    """``float(value)`` or a ValueError naming the parameter and its valid range."""
+    try:
+        return float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number {valid}, got {value!r}") from None
 
 
 def check_positive(name: str, value: float, unit: str) -> float:
