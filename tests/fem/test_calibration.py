@@ -21,12 +21,17 @@ LAWS = {  # law name -> (k key, p key)
 }
 
 # Coarse-versus-medium difference of each fitted law, max over w/D0 in [0.02, 0.15],
-# measured when the law was shipped (see the final report of the FEM work), plus a
-# margin of a third: a re-calibration on the coarse meshes must land within it.
+# measured when the law was shipped: line 1.8 %, width 3.9 %, contact fraction 4.0 %,
+# line peak pressure 2.8 %, point force 7.3 %, patch axial 2.6 %, patch transverse 3.9 %,
+# point peak pressure 9.7 %, area deficit 1.6 %. Most of it is the unresolved smallest
+# steps (w/D0 < 0.01, patch below two elements) pulling the log-log fit; the values at
+# w/D0 = 0.15 agree within 1.3 % (indent force) and 0.2 % (squeeze force). Tolerance:
+# the measured difference plus a third, so a change of the physics or of a definition
+# (tens of %) fails while the known discretisation error passes.
 COARSE_TOLERANCE = {
-    "line": 0.01, "width": 0.05, "contact_fraction": 0.05, "pmax_line": 0.03,
-    "point": 0.05, "patch_axial": 0.15, "patch_transverse": 0.15, "pmax_point": 0.15,
-    "area": 0.05,
+    "line": 0.025, "width": 0.052, "contact_fraction": 0.053, "pmax_line": 0.038,
+    "point": 0.098, "patch_axial": 0.035, "patch_transverse": 0.052, "pmax_point": 0.13,
+    "area": 0.022,
 }
 
 

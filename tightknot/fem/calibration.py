@@ -23,11 +23,11 @@ k_area, p_area        A / A0 = (1 / stretch) (1 - k_area w_hat^p_area)       squ
 ``fits_w_hat_ge_0p01`` holds the same laws fitted over w_hat in [0.01, 0.15] only (a
 single power law cannot follow the logarithmic small-load line contact, Johnson 1985
 sec. 5.6, and the coarse meshes do not resolve patches below w_hat = 0.01), with their
-own max relative errors. ``residuals`` holds, per law, the maximum relative error of the fit over the fitted FEM
-points; ``hertz`` the small-strain (Hertz) values of the same laws for comparison;
-``provenance`` the scenes, meshes, FElupe version, date, bulk modulus and definitions.
-Fits are least squares in log-log space (scipy.optimize.curve_fit on log y = log k +
-p log w_hat).
+own max relative errors. ``residuals`` holds, per law, the maximum relative error of
+the fit over the fitted FEM points; ``hertz`` the small-strain (Hertz) values of the
+same laws for comparison; ``provenance`` the scenes, meshes, FElupe version, date,
+bulk modulus and definitions. Fits are least squares in log-log space
+(scipy.optimize.curve_fit on log y = log k + p log w_hat).
 """
 
 from __future__ import annotations
