@@ -32,10 +32,11 @@ class ExtraTerm(Protocol):
     name: str
 
     def evaluate(
-        self, x: np.ndarray, want_grad: bool, want_hess: bool
+        self, x: np.ndarray, rest: np.ndarray, want_grad: bool, want_hess: bool
     ) -> tuple[float, np.ndarray | None, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
-        """Energy [J], gradient over position dofs (vertex_count, 3) [N], and Hessian COO
-        triplets over global dofs (rows, cols, values)."""
+        """Energy [J] at positions ``x`` and edge rest lengths ``rest``, gradient over
+        position dofs (vertex_count, 3) [N], and Hessian COO triplets over global dofs
+        (rows, cols, values)."""
         ...
 
     def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
@@ -125,6 +126,14 @@ class RodSystem:
         self._trial: tuple[np.ndarray, ...] | None = None
         self.set_load(0.0)
 
+    def add_term(self, term: ExtraTerm) -> None:
+        """Add an energy term (e.g. the contact layer); a term that can check the state
+        (``check_no_intersection``) refuses a start that already violates it."""
+        check = getattr(term, "check_no_intersection", None)
+        if check is not None:
+            check(self.state.x)
+        self.extra_terms.append(term)
+
     # -- load path -------------------------------------------------------------------
     def set_load(self, t: float) -> None:
         """Move to load parameter t: rest lengths, dead loads and prescribed dofs."""
@@ -184,7 +193,7 @@ class RodSystem:
         if grad is not None:
             grad[m.position_dofs] -= self.f_ext
         for term in self.extra_terms:
-            e_k, g_k, h_k = term.evaluate(x, want_grad or want_hess, want_hess)
+            e_k, g_k, h_k = term.evaluate(x, self.rest, want_grad or want_hess, want_hess)
             split.extra[term.name] = e_k
             if grad is not None and g_k is not None:
                 grad[m.position_dofs] += g_k

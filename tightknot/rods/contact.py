@@ -1,0 +1,302 @@
+"""Self-contact of rods with a radial-compliance layer: the term the Newton solver adds.
+
+Detection: a Warp BVH over the edges' bounds (inflated by the interaction range), rebuilt at
+every evaluation; candidate edge pairs go to a fixed-capacity buffer that grows (and the
+query reruns) when it overflows, so no contact is ever dropped. Pairs closer along the rod
+than the exclusion window are skipped; the window is ``pi D/2`` of rest arc length: on the
+tightest bend a tube allows (radius D/2) two points an arc s apart are a chord
+``D sin(s/D)`` apart, below D (touching) for every s < pi D/2, so a shorter window would
+make a tight but legal bend touch itself (with a C2 ramp over the next quarter window).
+
+Energy, gradient and Hessian: :mod:`tightknot.rods.contact_kernels` (the law:
+:mod:`tightknot.rods.contact_law`). No passing through: :meth:`ContactLayer.max_step`
+bounds every Newton step so that no two non-local segments come closer than the hard limit
+(``hard_fraction`` x D) anywhere along the step.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from tightknot.rods import contact_kernels as ck
+from tightknot.rods.contact_law import RadialComplianceLaw
+from tightknot.rods.model import Model
+from tightknot.warp_setup import init_warp
+
+#: Gauss-Legendre points and weights on [0, 1].
+_GAUSS = {
+    1: ([0.5], [1.0]),
+    2: ([0.5 - 0.5 / math.sqrt(3.0), 0.5 + 0.5 / math.sqrt(3.0)], [0.5, 0.5]),
+    3: ([0.5 - 0.5 * math.sqrt(0.6), 0.5, 0.5 + 0.5 * math.sqrt(0.6)],
+        [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0]),
+}
+
+
+class SelfIntersectionError(ValueError):
+    """The rods already pass through each other (closer than the hard limit)."""
+
+
+@dataclass
+class ContactReport:
+    """Per-vertex contact outputs (see :meth:`ContactLayer.report`).
+
+    Attributes:
+        overlap: largest pair overlap delta at the vertex [m] (0 when free).
+        overlap_opposite: largest overlap from the opposite side [m].
+        force_per_length: contact force per unit length on the vertex [N/m].
+        half_width: line-contact half-width b [m].
+        contact_width_fraction: L_c, fraction of the perimeter in contact [-].
+        mean_pressure_over_E: mean contact pressure over E [-].
+        peak_pressure_over_E: peak contact pressure over E [-].
+        area_ratio: section area A/A0 from stretch and squeeze (incompressible) [-].
+        pairs: contact point pairs (i, j) as vertex indices with their overlap [m].
+    """
+
+    overlap: np.ndarray
+    overlap_opposite: np.ndarray
+    force_per_length: np.ndarray
+    half_width: np.ndarray
+    contact_width_fraction: np.ndarray
+    mean_pressure_over_E: np.ndarray
+    peak_pressure_over_E: np.ndarray
+    area_ratio: np.ndarray
+    pairs: np.ndarray
+
+
+class ContactLayer:
+    """Self-contact (and rod-rod contact) of a model's rods, compliant or rigid-tube.
+
+    Args:
+        model: the rods.
+        law: the radial-compliance law (default: the shipped FEM calibration).
+        gauss_points: quadrature points per edge (1 to 3).
+        exclusion_factor: exclusion window over the rest diameter (default pi/2, derived
+            in the module docstring).
+        hard_fraction: hard limit of the centerline distance over the pair's rest diameter;
+            a Newton step never brings two non-local segments closer.
+        initial_capacity: first size of the candidate-pair buffer (grows on demand).
+    """
+
+    name = "contact"
+
+    def __init__(
+        self,
+        model: Model,
+        law: RadialComplianceLaw | None = None,
+        gauss_points: int = 2,
+        exclusion_factor: float = math.pi / 2,
+        hard_fraction: float = 0.1,
+        initial_capacity: int = 1024,
+    ) -> None:
+        init_warp()
+        if gauss_points not in _GAUSS:
+            raise ValueError(f"gauss_points must be 1, 2 or 3, got {gauss_points}")
+        if not (math.isfinite(exclusion_factor) and exclusion_factor >= math.pi / 2):
+            raise ValueError(f"exclusion_factor must be >= pi/2, got {exclusion_factor}")
+        if not (0.0 < hard_fraction < 1.0):
+            raise ValueError(f"hard_fraction must be in (0, 1), got {hard_fraction}")
+        self.model = model
+        self.law = law or RadialComplianceLaw.from_json()
+        self.hard_fraction = float(hard_fraction)
+        dev = model.device
+        self.device = dev
+        m = model
+        diam = 2.0 * m.edge_radius
+        self.edge_diameter = diam
+        nu = np.array([m.rods[r].material.poisson_ratio for r in m.edge_rod])
+        emod = np.array([m.rods[r].material.youngs_modulus for r in m.edge_rod])
+        self.edge_modulus = emod
+        f64 = wp.float64
+        self._edge_vertex = m.wp("edge_vertex")
+        self._edge_rod = wp.array(m.edge_rod, dtype=wp.int32, device=dev)
+        self._rod_closed = wp.array([int(r.closed) for r in m.rods], dtype=wp.int32, device=dev)
+        self._radius0 = wp.array(m.edge_radius, dtype=f64, device=dev)
+        self._poisson = wp.array(nu, dtype=f64, device=dev)
+        self._modulus = wp.array(emod, dtype=f64, device=dev)
+        xi, w = _GAUSS[gauss_points]
+        self._gxi = wp.array(xi, dtype=f64, device=dev)
+        self._gw = wp.array(w, dtype=f64, device=dev)
+        law_ = self.law
+        a_l = law_.p_line + 0.5
+        beta = math.sqrt(math.pi) * math.gamma(a_l + 1.0) / math.gamma(a_l + 1.5)
+        self._law = wp.array([
+            law_.k_line, law_.p_line + 1.0, beta, law_.k_point, law_.p_point + 1.0,
+            math.cos(math.radians(law_.angle_line_deg)) ** 2,
+            math.cos(math.radians(law_.angle_point_deg)) ** 2, law_.smoothing,
+        ], dtype=f64, device=dev)
+        self._exclusion = wp.array(exclusion_factor * diam, dtype=f64, device=dev)
+        self._hard = wp.array(hard_fraction * diam, dtype=f64, device=dev)
+        # Interaction range of an edge: its radius, grown if compressed (r0 lam^-nu with
+        # lam >= 0.5 is at most 2^nu r0 <= 1.42 r0), so half the pair range is covered.
+        self._margin = wp.array(1.5 * m.edge_radius, dtype=f64, device=dev)
+        self._zero_dx = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
+        self._capacity = int(initial_capacity)
+        self._alloc(self._capacity)
+        self.last_pairs = np.zeros((0, 2), dtype=np.int32)
+        self.last_overlap = np.zeros(0)
+
+    # -- buffers and detection -------------------------------------------------------------
+    def _alloc(self, capacity: int) -> None:
+        self._pairs = wp.zeros(capacity, dtype=wp.vec2i, device=self.device)
+        self._count = wp.zeros(1, dtype=wp.int32, device=self.device)
+
+    def _arcs(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
+        m = self.model
+        arcs = np.zeros((m.edge_count, 2))
+        lengths = np.zeros(len(m.rods))
+        for r, rod in enumerate(m.rods):
+            le = rest[rod.edge_slice]
+            s1 = np.cumsum(le)
+            arcs[rod.edge_slice, 0] = s1 - le
+            arcs[rod.edge_slice, 1] = s1
+            lengths[r] = s1[-1]
+        return (wp.array(arcs, dtype=wp.vec2d, device=self.device),
+                wp.array(lengths, dtype=wp.float64, device=self.device))
+
+    def _candidates(self, wx: wp.array, wdx: wp.array, margin: wp.array,
+                    arcs: wp.array, rod_len: wp.array) -> wp.array:
+        m = self.model
+        dev = self.device
+        lower = wp.empty(m.edge_count, dtype=wp.vec3, device=dev)
+        upper = wp.empty(m.edge_count, dtype=wp.vec3, device=dev)
+        wp.launch(ck.edge_bounds_kernel, dim=m.edge_count, device=dev,
+                  inputs=[self._edge_vertex, wx, wdx, margin], outputs=[lower, upper])
+        bvh = wp.Bvh(lower, upper)
+        while True:
+            self._count.zero_()
+            wp.launch(ck.candidate_pairs_kernel, dim=m.edge_count, device=dev,
+                      inputs=[self._edge_rod, self._rod_closed, bvh.id, lower, upper, arcs,
+                              rod_len, self._exclusion, self._capacity],
+                      outputs=[self._count, self._pairs])
+            n = int(self._count.numpy()[0])
+            if n <= self._capacity:
+                return self._pairs[:n]
+            # Overflow: grow and query again, never drop a candidate.
+            self._capacity = int(2 ** math.ceil(math.log2(n * 1.25)))
+            self._alloc(self._capacity)
+
+    # -- the energy term -------------------------------------------------------------------
+    def evaluate(
+        self, x: np.ndarray, rest: np.ndarray, want_grad: bool = True, want_hess: bool = True
+    ) -> tuple[float, np.ndarray | None, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
+        """Contact energy [J], gradient over vertex positions (N, 3) [N], Hessian COO
+        triplets over global dofs."""
+        m = self.model
+        dev = self.device
+        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
+        arcs, rod_len = self._arcs(rest)
+        pairs = self._candidates(wx, self._zero_dx, self._margin, arcs, rod_len)
+        npairs = pairs.shape[0]
+        grad = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
+        if npairs == 0:
+            self.last_pairs = np.zeros((0, 2), dtype=np.int32)
+            self.last_overlap = np.zeros(0)
+            empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+            return 0.0, (np.zeros((m.vertex_count, 3)) if want_grad else None), (
+                empty if want_hess else None)
+        energy = wp.zeros(npairs, dtype=wp.float64, device=dev)
+        overlap = wp.zeros(npairs, dtype=wp.float64, device=dev)
+        hess = wp.zeros(npairs * 144 if want_hess else 1, dtype=wp.float64, device=dev)
+        wrest = wp.array(np.ascontiguousarray(rest), dtype=wp.float64, device=dev)
+        wp.launch(ck.contact_pair_kernel, dim=npairs, device=dev,
+                  inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, self._radius0,
+                          self._poisson, self._modulus, self._gxi, self._gw, self._law, wx,
+                          pairs, wrest, arcs, rod_len, self._exclusion,
+                          int(want_grad or want_hess), int(want_hess)],
+                  outputs=[energy, grad, hess, overlap])
+        e = float(energy.numpy().sum())
+        pr = pairs.numpy().astype(np.int64)
+        self.last_pairs = pr
+        self.last_overlap = overlap.numpy().copy()
+        g = grad.numpy().copy() if want_grad else None
+        coo = None
+        if want_hess:
+            ev = m.edge_vertex.astype(np.int64)
+            verts = np.concatenate([ev[pr[:, 0]], ev[pr[:, 1]]], axis=1)  # (P, 4)
+            dofs = (m.vertex_dof.astype(np.int64)[verts][:, :, None] + np.arange(3)).reshape(
+                -1, 12)
+            rows = np.broadcast_to(dofs[:, :, None], (npairs, 12, 12)).ravel()
+            cols = np.broadcast_to(dofs[:, None, :], (npairs, 12, 12)).ravel()
+            coo = (rows, cols, hess.numpy().copy())
+        return e, g, coo
+
+    # -- no passing through ----------------------------------------------------------------
+    def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
+        """Largest fraction of the step ``dx`` [m] (vertices) that keeps every non-local
+        segment pair at least the hard limit apart along the straight path (1 = full)."""
+        m = self.model
+        dev = self.device
+        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
+        wdx = wp.array(np.ascontiguousarray(dx), dtype=wp.vec3d, device=dev)
+        arcs, rod_len = self._arcs(m.edge_rest_length)
+        # Sweep each edge's bounds over the step, inflated by half the hard limit.
+        pairs = self._candidates(wx, wdx, self._half_hard(), arcs, rod_len)
+        n = pairs.shape[0]
+        if n == 0:
+            return 1.0
+        alpha = wp.zeros(n, dtype=wp.float64, device=dev)
+        dist = wp.zeros(n, dtype=wp.float64, device=dev)
+        wp.launch(ck.step_bound_kernel, dim=n, device=dev,
+                  inputs=[self._edge_vertex, wx, wdx, pairs, self._hard],
+                  outputs=[alpha, dist])
+        return float(np.clip(alpha.numpy().min(), 0.0, 1.0))
+
+    def _half_hard(self) -> wp.array:
+        return wp.array(0.5 * self.hard_fraction * self.edge_diameter, dtype=wp.float64,
+                        device=self.device)
+
+    def check_no_intersection(self, x: np.ndarray) -> None:
+        """Refuse positions whose non-local segments are closer than the hard limit,
+        saying where (rest arc lengths of the offending pair)."""
+        m = self.model
+        dev = self.device
+        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
+        arcs, rod_len = self._arcs(m.edge_rest_length)
+        pairs = self._candidates(wx, self._zero_dx, self._half_hard(), arcs, rod_len)
+        n = pairs.shape[0]
+        if n == 0:
+            return
+        alpha = wp.zeros(n, dtype=wp.float64, device=dev)
+        dist = wp.zeros(n, dtype=wp.float64, device=dev)
+        wp.launch(ck.step_bound_kernel, dim=n, device=dev,
+                  inputs=[self._edge_vertex, wx, self._zero_dx, pairs, self._hard],
+                  outputs=[alpha, dist])
+        d = dist.numpy()
+        pr = pairs.numpy()
+        hard = np.maximum(self.hard_fraction * self.edge_diameter[pr[:, 0]],
+                          self.hard_fraction * self.edge_diameter[pr[:, 1]])
+        bad = np.flatnonzero(d < hard)
+        if bad.size:
+            k = bad[np.argmin(d[bad] / hard[bad])]
+            a, b = pr[k]
+            ar = arcs.numpy()
+            raise SelfIntersectionError(
+                f"the rods intersect themselves: edges {a} and {b} (rest arc lengths "
+                f"{ar[a][0]:.6g}..{ar[a][1]:.6g} m and {ar[b][0]:.6g}..{ar[b][1]:.6g} m) are "
+                f"{d[k]:.4g} m apart, below the hard limit {hard[k]:.4g} m "
+                f"({self.hard_fraction:g} D)")
+
+    def min_distance(self, x: np.ndarray) -> tuple[float, int, int]:
+        """Smallest non-local segment distance [m] among pairs within the interaction
+        range, and its edge pair (inf, -1, -1 when none)."""
+        m = self.model
+        dev = self.device
+        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
+        arcs, rod_len = self._arcs(m.edge_rest_length)
+        pairs = self._candidates(wx, self._zero_dx, self._margin, arcs, rod_len)
+        n = pairs.shape[0]
+        if n == 0:
+            return math.inf, -1, -1
+        alpha = wp.zeros(n, dtype=wp.float64, device=dev)
+        dist = wp.zeros(n, dtype=wp.float64, device=dev)
+        wp.launch(ck.step_bound_kernel, dim=n, device=dev,
+                  inputs=[self._edge_vertex, wx, self._zero_dx, pairs, self._hard],
+                  outputs=[alpha, dist])
+        d = dist.numpy()
+        k = int(np.argmin(d))
+        pr = pairs.numpy()
+        return float(d[k]), int(pr[k][0]), int(pr[k][1])

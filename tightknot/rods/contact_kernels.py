@@ -1,0 +1,491 @@
+"""Warp kernels of the self-contact layer: broad phase, pair energy, step bound, outputs.
+
+One module, compiled once. Float64 geometry (tight contact needs it); the BVH bounds are
+float32 (Warp's BVH), inflated by a margin that covers their rounding.
+
+Pair energy (see :mod:`tightknot.rods.contact_law` for the derivation): for an edge pair
+(a, b) and Gauss points g on a, h on b,
+
+    U_gh = om_g om_h l_a l_b W_excl Psi(s, R, q),   s = |x_g - x_h|^2,
+    Psi = (1 - xi(q)) C_l h(x)^al_l + xi(q) sqrt(1 - q) C_p h(x)^al_p,
+    x = (R^2 - s)/(2R),  R = r_a + r_b,  r = r0 (l/l_bar)^-nu,  q = cos^2(angle of a, b),
+
+with om the Gauss weights on [0, 1], l the current edge lengths (the law is per unit length
+of the deformed rod), xi the C2 line-to-point blend by angle (Meier et al. 2016) and
+W_excl a C2 ramp of the arc-length separation (the exclusion window). U is a function of
+four scalars z = (s, l_a, l_b, q) of the vectors Y = (r = x_g - x_h, e_a, e_b); gradient
+and Hessian follow by the chain rule through z and Y, then the linear map Y -> vertices.
+Local vertex order of a pair: [a0, a1, b0, b1]; Hessian entry (3 v + i, 3 w + j) at
+``pair * 144 + (3 v + i) * 12 + 3 w + j``.
+"""
+
+from __future__ import annotations
+
+import warp as wp
+
+f64 = wp.float64
+
+
+@wp.func
+def smooth_ramp(u: wp.float64) -> wp.vec3d:
+    """Quintic smoothstep S(u) on [0, 1] (C2), with S' and S''."""
+    if u <= f64(0.0):
+        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
+    if u >= f64(1.0):
+        return wp.vec3d(f64(1.0), f64(0.0), f64(0.0))
+    u2 = u * u
+    s = u2 * u * (f64(10.0) - f64(15.0) * u + f64(6.0) * u2)
+    s1 = f64(30.0) * u2 * (f64(1.0) - u) * (f64(1.0) - u)
+    s2 = f64(60.0) * u * (f64(1.0) - u) * (f64(1.0) - f64(2.0) * u)
+    return wp.vec3d(s, s1, s2)
+
+
+@wp.func
+def positive_part(x: wp.float64, eps: wp.float64) -> wp.vec3d:
+    """C2 positive part h(x) with onset band [-eps, eps], and h', h''.
+
+    h = (x + eps)^3 (3 eps - x)/(16 eps^3) inside the band: h(-eps) = h'(-eps) = h''(-eps) = 0
+    and h(eps) = eps, h'(eps) = 1, h''(eps) = 0.
+    """
+    if x <= -eps:
+        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
+    if x >= eps:
+        return wp.vec3d(x, f64(1.0), f64(0.0))
+    y = x + eps
+    e3 = f64(16.0) * eps * eps * eps
+    h = y * y * y * (f64(3.0) * eps - x) / e3
+    h1 = (f64(3.0) * y * y * (f64(3.0) * eps - x) - y * y * y) / e3
+    h2 = (f64(6.0) * y * (f64(3.0) * eps - x) - f64(6.0) * y * y) / e3
+    return wp.vec3d(h, h1, h2)
+
+
+@wp.func
+def power_of_ramp(hv: wp.vec3d, coef: wp.float64, alpha: wp.float64) -> wp.vec3d:
+    """G = coef h^alpha and its first two derivatives in x, given (h, h', h'')."""
+    h = hv[0]
+    if h <= f64(1.0e-300):
+        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
+    ha = wp.pow(h, alpha)
+    g = coef * ha
+    g1 = coef * alpha * ha / h * hv[1]
+    g2 = coef * alpha * (ha / h) * ((alpha - f64(1.0)) / h * hv[1] * hv[1] + hv[2])
+    return wp.vec3d(g, g1, g2)
+
+
+@wp.func
+def arc_separation(sa: wp.float64, sb: wp.float64, same_rod: int, closed: int,
+                   rod_length: wp.float64) -> wp.float64:
+    if same_rod == 0:
+        return f64(1.0e30)
+    d = wp.abs(sa - sb)
+    if closed != 0:
+        d = wp.min(d, rod_length - d)
+    return d
+
+
+@wp.func
+def outer33(a: wp.vec3d, b: wp.vec3d) -> wp.mat33d:
+    return wp.outer(a, b)
+
+
+@wp.func
+def block(Fzz: wp.mat44d, ga0: wp.vec3d, ga1: wp.vec3d, ga2: wp.vec3d, ga3: wp.vec3d,
+          gb0: wp.vec3d, gb1: wp.vec3d, gb2: wp.vec3d, gb3: wp.vec3d) -> wp.mat33d:
+    """sum_kl Fzz[k, l] outer(ga_k, gb_l): the Gauss-Newton part of a Y-space block."""
+    m = wp.mat33d()
+    m = m + outer33(ga0, Fzz[0, 0] * gb0 + Fzz[0, 1] * gb1 + Fzz[0, 2] * gb2 + Fzz[0, 3] * gb3)
+    m = m + outer33(ga1, Fzz[1, 0] * gb0 + Fzz[1, 1] * gb1 + Fzz[1, 2] * gb2 + Fzz[1, 3] * gb3)
+    m = m + outer33(ga2, Fzz[2, 0] * gb0 + Fzz[2, 1] * gb1 + Fzz[2, 2] * gb2 + Fzz[2, 3] * gb3)
+    m = m + outer33(ga3, Fzz[3, 0] * gb0 + Fzz[3, 1] * gb1 + Fzz[3, 2] * gb2 + Fzz[3, 3] * gb3)
+    return m
+
+
+@wp.func
+def add_hess(out: wp.array(dtype=wp.float64), base: int, v: int, w: int, m: wp.mat33d):
+    for i in range(3):
+        for j in range(3):
+            out[base + (3 * v + i) * 12 + 3 * w + j] += m[i, j]
+
+
+@wp.kernel
+def edge_bounds_kernel(
+    # Model:
+    edge_vertex: wp.array(dtype=wp.vec2i),
+    # Data in:
+    x_in: wp.array(dtype=wp.vec3d),
+    dx_in: wp.array(dtype=wp.vec3d),
+    margin_in: wp.array(dtype=wp.float64),
+    # Out:
+    lower_out: wp.array(dtype=wp.vec3),
+    upper_out: wp.array(dtype=wp.vec3),
+):
+    # Bounds of each edge swept by the step dx (zero for a static query), inflated by its
+    # margin; float32, padded so rounding never shrinks them.
+    j = wp.tid()
+    v = edge_vertex[j]
+    p0 = x_in[v[0]]
+    p1 = x_in[v[1]]
+    q0 = p0 + dx_in[v[0]]
+    q1 = p1 + dx_in[v[1]]
+    lo = wp.min(wp.min(p0, p1), wp.min(q0, q1))
+    hi = wp.max(wp.max(p0, p1), wp.max(q0, q1))
+    m = margin_in[j] * f64(1.0001) + f64(1.0e-9)
+    mv = wp.vec3d(m, m, m)
+    lower_out[j] = wp.vec3(lo - mv)
+    upper_out[j] = wp.vec3(hi + mv)
+
+
+@wp.kernel
+def candidate_pairs_kernel(
+    # Model:
+    edge_rod: wp.array(dtype=wp.int32),
+    rod_closed: wp.array(dtype=wp.int32),
+    # Data in:
+    bvh_id: wp.uint64,
+    lower_in: wp.array(dtype=wp.vec3),
+    upper_in: wp.array(dtype=wp.vec3),
+    edge_arc_in: wp.array(dtype=wp.vec2d),
+    rod_length_in: wp.array(dtype=wp.float64),
+    edge_exclusion_in: wp.array(dtype=wp.float64),
+    capacity: int,
+    # Out:
+    count_out: wp.array(dtype=wp.int32),
+    pairs_out: wp.array(dtype=wp.vec2i),
+):
+    # Edge pairs (a < b) whose bounds overlap and that hold at least one point pair
+    # farther apart along the rod than the exclusion window.
+    a = wp.tid()
+    query = wp.bvh_query_aabb(bvh_id, lower_in[a], upper_in[a])
+    b = int(0)
+    ra = edge_rod[a]
+    arc_a = edge_arc_in[a]
+    while wp.bvh_query_next(query, b):
+        if b <= a:
+            continue
+        same = int(0)
+        if edge_rod[b] == ra:
+            same = 1
+        if same != 0:
+            arc_b = edge_arc_in[b]
+            excl = wp.max(edge_exclusion_in[a], edge_exclusion_in[b])
+            # Largest separation of any two points of the two edges.
+            s1 = arc_separation(arc_a[0], arc_b[1], 1, rod_closed[ra], rod_length_in[ra])
+            s2 = arc_separation(arc_a[1], arc_b[0], 1, rod_closed[ra], rod_length_in[ra])
+            s3 = arc_separation(arc_a[0], arc_b[0], 1, rod_closed[ra], rod_length_in[ra])
+            s4 = arc_separation(arc_a[1], arc_b[1], 1, rod_closed[ra], rod_length_in[ra])
+            if wp.max(wp.max(s1, s2), wp.max(s3, s4)) < excl:
+                continue
+        k = wp.atomic_add(count_out, 0, 1)
+        if k < capacity:
+            pairs_out[k] = wp.vec2i(a, b)
+
+
+@wp.kernel
+def contact_pair_kernel(
+    # Model:
+    edge_vertex: wp.array(dtype=wp.vec2i),
+    edge_rod: wp.array(dtype=wp.int32),
+    rod_closed: wp.array(dtype=wp.int32),
+    edge_radius0: wp.array(dtype=wp.float64),
+    edge_poisson: wp.array(dtype=wp.float64),
+    edge_modulus: wp.array(dtype=wp.float64),
+    gauss_xi: wp.array(dtype=wp.float64),
+    gauss_w: wp.array(dtype=wp.float64),
+    law: wp.array(dtype=wp.float64),
+    # Data in:
+    x_in: wp.array(dtype=wp.vec3d),
+    pairs_in: wp.array(dtype=wp.vec2i),
+    edge_rest_length_in: wp.array(dtype=wp.float64),
+    edge_arc_in: wp.array(dtype=wp.vec2d),
+    rod_length_in: wp.array(dtype=wp.float64),
+    edge_exclusion_in: wp.array(dtype=wp.float64),
+    want_grad: int,
+    want_hess: int,
+    # Out:
+    energy_out: wp.array(dtype=wp.float64),
+    grad_out: wp.array(dtype=wp.vec3d),
+    hess_out: wp.array(dtype=wp.float64),
+    overlap_out: wp.array(dtype=wp.float64),
+):
+    p = wp.tid()
+    pr = pairs_in[p]
+    a = pr[0]
+    b = pr[1]
+    va = edge_vertex[a]
+    vb = edge_vertex[b]
+    xa0 = x_in[va[0]]
+    xa1 = x_in[va[1]]
+    xb0 = x_in[vb[0]]
+    xb1 = x_in[vb[1]]
+    ea = xa1 - xa0
+    eb = xb1 - xb0
+    la = wp.length(ea)
+    lb = wp.length(eb)
+    ta = ea / la
+    tb = eb / lb
+    # Law parameters: [k_line, m_line, beta_line, k_point, m_point, q_line, q_point, eps].
+    k_l = law[0]
+    m_l = law[1]
+    beta_l = law[2]
+    k_p = law[3]
+    m_p = law[4]
+    q_line = law[5]
+    q_point = law[6]
+    eps_rel = law[7]
+    # Pair constants from the rest diameter D = r0a + r0b and the harmonic-mean modulus.
+    d0 = edge_radius0[a] + edge_radius0[b]
+    emod = f64(2.0) * edge_modulus[a] * edge_modulus[b] / (edge_modulus[a] + edge_modulus[b])
+    two_d = f64(2.0) * d0
+    C_l = f64(2.0) * k_l * emod * d0 * d0 * wp.pow(two_d, -m_l) / m_l * wp.pow(
+        two_d, -f64(0.5)) / beta_l
+    al_l = m_l - f64(0.5)
+    C_p = k_p * emod * d0 * d0 * wp.pow(two_d, -m_p) / f64(3.141592653589793)
+    al_p = m_p - f64(1.0)
+    # Stretched radii r = r0 (l/l_bar)^-nu and their derivatives in l.
+    nua = edge_poisson[a]
+    nub = edge_poisson[b]
+    r_a = edge_radius0[a] * wp.pow(la / edge_rest_length_in[a], -nua)
+    r_b = edge_radius0[b] * wp.pow(lb / edge_rest_length_in[b], -nub)
+    R = r_a + r_b
+    R_a = -nua * r_a / la
+    R_b = -nub * r_b / lb
+    R_aa = nua * (nua + f64(1.0)) * r_a / (la * la)
+    R_bb = nub * (nub + f64(1.0)) * r_b / (lb * lb)
+    # Angle: c = ta . tb, q = c^2 and its gradients in e_a, e_b.
+    c = wp.dot(ta, tb)
+    q = c * c
+    dc_a = (tb - c * ta) / la
+    dc_b = (ta - c * tb) / lb
+    dq_a = f64(2.0) * c * dc_a
+    dq_b = f64(2.0) * c * dc_b
+    # Blend xi(q): 1 (point) for q <= q_point, 0 (line) for q >= q_line.
+    sv = smooth_ramp((q_line - q) / (q_line - q_point))
+    inv_dq = f64(-1.0) / (q_line - q_point)
+    xi = sv[0]
+    xi1 = sv[1] * inv_dq
+    xi2 = sv[2] * inv_dq * inv_dq
+    A = f64(1.0) - xi
+    A1 = -xi1
+    A2 = -xi2
+    sn = wp.sqrt(wp.max(f64(1.0) - q, f64(0.0)))
+    B = f64(0.0)
+    B1 = f64(0.0)
+    B2 = f64(0.0)
+    if xi > f64(0.0):
+        # sqrt(1 - q) is smooth where xi > 0 (q <= q_line < 1).
+        s1 = -f64(0.5) / sn
+        s2 = -f64(0.25) / (sn * sn * sn)
+        B = xi * sn
+        B1 = xi1 * sn + xi * s1
+        B2 = xi2 * sn + f64(2.0) * xi1 * s1 + xi * s2
+    eps = eps_rel * d0
+    ng = gauss_xi.shape[0]
+    ra_ = edge_rod[a]
+    same = int(0)
+    if edge_rod[b] == ra_:
+        same = 1
+    excl = wp.max(edge_exclusion_in[a], edge_exclusion_in[b])
+    arc_a = edge_arc_in[a]
+    arc_b = edge_arc_in[b]
+    energy = f64(0.0)
+    g0 = wp.vec3d()
+    g1 = wp.vec3d()
+    g2 = wp.vec3d()
+    g3 = wp.vec3d()
+    base = p * 144
+    if want_hess != 0:
+        for k in range(144):
+            hess_out[base + k] = f64(0.0)
+    xmax = f64(-1.0e30)
+    zero3 = wp.vec3d()
+    for gi in range(ng):
+        for hi in range(ng):
+            xg = gauss_xi[gi]
+            xh = gauss_xi[hi]
+            sa = arc_a[0] + xg * (arc_a[1] - arc_a[0])
+            sb = arc_b[0] + xh * (arc_b[1] - arc_b[0])
+            sep = arc_separation(sa, sb, same, rod_closed[ra_], rod_length_in[ra_])
+            wex = smooth_ramp((sep - excl) / (f64(0.25) * excl))[0]
+            if same == 0:
+                wex = f64(1.0)
+            if wex <= f64(0.0):
+                continue
+            r = (xa0 + xg * ea) - (xb0 + xh * eb)
+            s = wp.dot(r, r)
+            x = (R * R - s) / (f64(2.0) * R)
+            xmax = wp.max(xmax, x)
+            if x <= -eps:
+                continue
+            hv = positive_part(x, eps)
+            Gl = power_of_ramp(hv, C_l, al_l)
+            Gp = power_of_ramp(hv, C_p, al_p)
+            Psi = A * Gl[0] + B * Gp[0]
+            wgt = gauss_w[gi] * gauss_w[hi] * wex
+            P = la * lb
+            energy += wgt * P * Psi
+            if want_grad == 0:
+                continue
+            Px = A * Gl[1] + B * Gp[1]
+            Pxx = A * Gl[2] + B * Gp[2]
+            Pq = A1 * Gl[0] + B1 * Gp[0]
+            Pqq = A2 * Gl[0] + B2 * Gp[0]
+            Pxq = A1 * Gl[1] + B1 * Gp[1]
+            x_s = -f64(0.5) / R
+            x_R = f64(0.5) + s / (f64(2.0) * R * R)
+            x_sR = f64(0.5) / (R * R)
+            x_RR = -s / (R * R * R)
+            Ps = Px * x_s
+            PR = Px * x_R
+            Pss = Pxx * x_s * x_s
+            PsR = Pxx * x_s * x_R + Px * x_sR
+            PRR = Pxx * x_R * x_R + Px * x_RR
+            Psq = Pxq * x_s
+            PRq = Pxq * x_R
+            # Psi in z = (s, l_a, l_b, q): R depends on l_a, l_b.
+            Pz = wp.vec4d(Ps, PR * R_a, PR * R_b, Pq)
+            Pzz = wp.mat44d(
+                Pss, PsR * R_a, PsR * R_b, Psq,
+                PsR * R_a, PRR * R_a * R_a + PR * R_aa, PRR * R_a * R_b, PRq * R_a,
+                PsR * R_b, PRR * R_a * R_b, PRR * R_b * R_b + PR * R_bb, PRq * R_b,
+                Psq, PRq * R_a, PRq * R_b, Pqq)
+            # F = P Psi with P = l_a l_b.
+            Pp = wp.vec4d(f64(0.0), lb, la, f64(0.0))
+            Fz = wgt * (P * Pz + Psi * Pp)
+            # Gradients of z in the Y blocks (r, e_a, e_b).
+            gr_s = f64(2.0) * r
+            ga_la = ta
+            gb_lb = tb
+            grad_r = Fz[0] * gr_s
+            grad_a = Fz[1] * ga_la + Fz[3] * dq_a
+            grad_b = Fz[2] * gb_lb + Fz[3] * dq_b
+            # Y -> vertices: r = (1-xg) xa0 + xg xa1 - (1-xh) xb0 - xh xb1.
+            g0 += (f64(1.0) - xg) * grad_r - grad_a
+            g1 += xg * grad_r + grad_a
+            g2 += -(f64(1.0) - xh) * grad_r - grad_b
+            g3 += -xh * grad_r + grad_b
+            if want_hess == 0:
+                continue
+            Fzz = wgt * (P * Pzz + wp.outer(Pp, Pz) + wp.outer(Pz, Pp))
+            Fzz[1, 2] = Fzz[1, 2] + wgt * Psi
+            Fzz[2, 1] = Fzz[2, 1] + wgt * Psi
+            eye = wp.identity(n=3, dtype=wp.float64)
+            Hrr = block(Fzz, gr_s, zero3, zero3, zero3, gr_s, zero3, zero3, zero3) + (
+                f64(2.0) * Fz[0]) * eye
+            Hra = block(Fzz, gr_s, zero3, zero3, zero3, zero3, ga_la, zero3, dq_a)
+            Hrb = block(Fzz, gr_s, zero3, zero3, zero3, zero3, zero3, gb_lb, dq_b)
+            # Second derivatives of q = c^2 (the Hessian of c: see module docstring).
+            ua = tb - c * ta
+            ub = ta - c * tb
+            Pa = eye - outer33(ta, ta)
+            Pb = eye - outer33(tb, tb)
+            Hc_aa = (-(outer33(ua, ta) + outer33(ta, ua)) - c * Pa) / (la * la)
+            Hc_bb = (-(outer33(ub, tb) + outer33(tb, ub)) - c * Pb) / (lb * lb)
+            Hc_ab = (Pb - outer33(ta, ub)) / (la * lb)
+            Hq_aa = f64(2.0) * (outer33(dc_a, dc_a) + c * Hc_aa)
+            Hq_bb = f64(2.0) * (outer33(dc_b, dc_b) + c * Hc_bb)
+            Hq_ab = f64(2.0) * (outer33(dc_a, dc_b) + c * Hc_ab)
+            Haa = block(Fzz, zero3, ga_la, zero3, dq_a, zero3, ga_la, zero3, dq_a) + (
+                Fz[1] / la) * Pa + Fz[3] * Hq_aa
+            Hbb = block(Fzz, zero3, zero3, gb_lb, dq_b, zero3, zero3, gb_lb, dq_b) + (
+                Fz[2] / lb) * Pb + Fz[3] * Hq_bb
+            Hab = block(Fzz, zero3, ga_la, zero3, dq_a, zero3, zero3, gb_lb, dq_b) + Fz[3] * Hq_ab
+            # Map to the 4 vertices: coefficient of (r, e_a, e_b) in each vertex.
+            cr = wp.vec4d(f64(1.0) - xg, xg, -(f64(1.0) - xh), -xh)
+            ca = wp.vec4d(f64(-1.0), f64(1.0), f64(0.0), f64(0.0))
+            cb = wp.vec4d(f64(0.0), f64(0.0), f64(-1.0), f64(1.0))
+            Har = wp.transpose(Hra)
+            Hbr = wp.transpose(Hrb)
+            Hba = wp.transpose(Hab)
+            for v in range(4):
+                for w in range(4):
+                    m = (cr[v] * cr[w]) * Hrr + (cr[v] * ca[w]) * Hra + (cr[v] * cb[w]) * Hrb
+                    m = m + (ca[v] * cr[w]) * Har + (ca[v] * ca[w]) * Haa + (ca[v] * cb[w]) * Hab
+                    m = m + (cb[v] * cr[w]) * Hbr + (cb[v] * ca[w]) * Hba + (cb[v] * cb[w]) * Hbb
+                    add_hess(hess_out, base, v, w, m)
+    energy_out[p] = energy
+    overlap_out[p] = xmax
+    if want_grad != 0:
+        wp.atomic_add(grad_out, va[0], g0)
+        wp.atomic_add(grad_out, va[1], g1)
+        wp.atomic_add(grad_out, vb[0], g2)
+        wp.atomic_add(grad_out, vb[1], g3)
+
+
+@wp.func
+def segment_distance(p0: wp.vec3d, p1: wp.vec3d, q0: wp.vec3d, q1: wp.vec3d) -> wp.vec3d:
+    """Closest points of segments [p0, p1], [q0, q1]: returns (distance, s, t).
+
+    Ericson, "Real-Time Collision Detection" (2005) sec. 5.1.9, with the parallel and
+    zero-length cases handled.
+    """
+    d1 = p1 - p0
+    d2 = q1 - q0
+    r = p0 - q0
+    a = wp.dot(d1, d1)
+    e = wp.dot(d2, d2)
+    f = wp.dot(d2, r)
+    tiny = f64(1.0e-30)
+    s = f64(0.0)
+    t = f64(0.0)
+    if a <= tiny and e <= tiny:
+        s = f64(0.0)
+        t = f64(0.0)
+    elif a <= tiny:
+        s = f64(0.0)
+        t = wp.clamp(f / e, f64(0.0), f64(1.0))
+    else:
+        c = wp.dot(d1, r)
+        if e <= tiny:
+            t = f64(0.0)
+            s = wp.clamp(-c / a, f64(0.0), f64(1.0))
+        else:
+            b = wp.dot(d1, d2)
+            denom = a * e - b * b
+            if denom > f64(1.0e-14) * a * e:
+                s = wp.clamp((b * f - c * e) / denom, f64(0.0), f64(1.0))
+            else:
+                s = f64(0.0)  # parallel: any s works; pick an end
+            t = (b * s + f) / e
+            if t < f64(0.0):
+                t = f64(0.0)
+                s = wp.clamp(-c / a, f64(0.0), f64(1.0))
+            elif t > f64(1.0):
+                t = f64(1.0)
+                s = wp.clamp((b - c) / a, f64(0.0), f64(1.0))
+    cp = p0 + s * d1
+    cq = q0 + t * d2
+    return wp.vec3d(wp.length(cp - cq), s, t)
+
+
+@wp.kernel
+def step_bound_kernel(
+    # Model:
+    edge_vertex: wp.array(dtype=wp.vec2i),
+    # Data in:
+    x_in: wp.array(dtype=wp.vec3d),
+    dx_in: wp.array(dtype=wp.vec3d),
+    pairs_in: wp.array(dtype=wp.vec2i),
+    hard_in: wp.array(dtype=wp.float64),
+    # Out:
+    alpha_out: wp.array(dtype=wp.float64),
+    distance_out: wp.array(dtype=wp.float64),
+):
+    # Segment distance is 1-Lipschitz in the motion of its points, and each point of an edge
+    # moves at most max(|dx| of its two vertices) along the straight step; so no point pair
+    # comes closer than d0 - alpha (m_a + m_b), and alpha = (d0 - hard)/(m_a + m_b) keeps the
+    # pair at least ``hard`` apart along the whole step: no passing through by construction.
+    p = wp.tid()
+    pr = pairs_in[p]
+    va = edge_vertex[pr[0]]
+    vb = edge_vertex[pr[1]]
+    res = segment_distance(x_in[va[0]], x_in[va[1]], x_in[vb[0]], x_in[vb[1]])
+    d0 = res[0]
+    distance_out[p] = d0
+    ma = wp.max(wp.length(dx_in[va[0]]), wp.length(dx_in[va[1]]))
+    mb = wp.max(wp.length(dx_in[vb[0]]), wp.length(dx_in[vb[1]]))
+    hard = wp.max(hard_in[pr[0]], hard_in[pr[1]])
+    move = ma + mb
+    alpha = f64(1.0e30)
+    if move > f64(0.0):
+        alpha = (d0 - hard) / move
+    alpha_out[p] = alpha

@@ -1,0 +1,213 @@
+"""The radial-compliance contact law: how hard two pieces of a deformable rod press.
+
+Definitions (the FEM calibration's, ``tightknot/fem/overlap.py``): two centerline points at
+distance d, section radii r_i, r_j (stretched sections), overlap ``delta = r_i + r_j - d``.
+The law is calibrated per side: ``w`` is the approach of one section's centroid to the
+contact plane; two identical rods pressed together have ``w = delta/2`` each.
+
+Per-side laws (non-dimensional power laws fitted to the small 3D solid FEM; defaults
+from the shipped ``tightknot/data/contact_law.json``):
+
+* line contact of parallel strands, force per unit length
+  ``f = k_line E D (w/D)^p_line`` [N/m];
+* point contact of crossing strands, force per contact
+  ``F = k_point E D^2 (w/D)^p_point`` [N].
+
+For the pair (``w = delta/2``) the energies are the integrals of the force over delta:
+``e_line(delta) = 2 k_line E D^2 (delta/2D)^(p+1)/(p+1)`` [J/m] and likewise
+``e_point(delta) = 2 k_point E D^3 (delta/2D)^(q+1)/(q+1)`` [J].
+
+Realisation on the rods (:mod:`tightknot.rods.contact_kernels`): the contact energy is a
+double integral over both centerlines of a pair kernel of the distance rho between two
+points, ``psi(rho) = C h(x)^alpha`` with ``x = (R^2 - rho^2)/(2R)``, R = r_i + r_j
+(x = delta + O(delta^2/R)), evaluated by Gauss quadrature on the edges. The kernel family
+is chosen because its integrals are exact powers of the same variable:
+
+* two parallel straight strands at distance d: integral over the second strand
+  ``int psi du = C (2R)^(-alpha) B(1/2, alpha + 1) (R^2 - d^2)^(alpha + 1/2)``
+  (Abel transform; Gradshteyn & Ryzhik 3.251.1), so ``alpha_line = p_line + 1/2`` gives
+  ``e_line`` with delta read as x exactly;
+* two straight strands crossing at angle phi: ``int int psi dA / sin(phi)
+  = (pi / sin phi) C (2R)^(-alpha) (R^2 - d^2)^(alpha + 1)/(alpha + 1)``, so
+  ``alpha_point = p_point`` and a pair weight ``sin(phi)`` give ``e_point``.
+
+The two are blended by crossing angle (Meier, Popp, Wall 2016, "A unified approach for
+beam-to-beam contact", CMAME 315:972: line contact below ``angle_line``, point contact above
+``angle_point``, a C2 blend between). ``h`` is a C2 positive part with a band ``smoothing``
+(relative to R) so that the energy is C2 everywhere.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+_LAW_FILE = Path(__file__).resolve().parents[1] / "data" / "contact_law.json"
+
+
+@dataclass(frozen=True)
+class RadialComplianceLaw:
+    """Parameters of the radial-compliance contact law (non-dimensional unless stated).
+
+    Attributes:
+        k_line, p_line: per-side line-contact force per length, f/(E D) = k (w/D)^p.
+        k_point, p_point: per-side point-contact force, F/(E D^2) = k (w/D)^p.
+        k_width, p_width: line-contact half-width, b/D = k (w/D)^p.
+        c_lc, p_lc: fraction of the perimeter in contact on one side, c (w/D)^p.
+        k_pmax_line, p_pmax_line: line-contact peak pressure, p_max/E = k (w/D)^p.
+        k_pmax_point, p_pmax_point: point-contact peak pressure, p_max/E = k (w/D)^p.
+        k_patch, p_patch: point-contact patch semi-axis, a/D = k (w/D)^p.
+        k_area, p_area: section area under squeeze, A/A0 = (1/stretch)(1 - k (w/D)^p).
+        angle_line_deg, angle_point_deg: crossing angles [deg] below which the contact is
+            a line contact and above which it is a point contact.
+        smoothing: half-width of the C2 onset band of the kernel, relative to R.
+        rigid: a rigid-tube law (stiff, for comparison): the outputs of a deformable
+            section (width, pressure, area) are then reported as zero / unchanged.
+        source: where the parameters come from.
+    """
+
+    k_line: float
+    p_line: float
+    k_point: float
+    p_point: float
+    k_width: float = 1.0
+    p_width: float = 0.6
+    c_lc: float = 0.64
+    p_lc: float = 0.6
+    k_pmax_line: float = 1.3
+    p_pmax_line: float = 0.6
+    k_pmax_point: float = 1.2
+    p_pmax_point: float = 0.5
+    k_patch: float = 0.71
+    p_patch: float = 0.5
+    k_area: float = 1.0
+    p_area: float = 1.2
+    angle_line_deg: float = 15.0
+    angle_point_deg: float = 35.0
+    smoothing: float = 1e-3
+    rigid: bool = False
+    source: str = "parameters"
+
+    def __post_init__(self) -> None:
+        for name in ("k_line", "k_point", "smoothing"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+        for name in ("p_line", "p_point"):
+            v = getattr(self, name)
+            # Energy ~ w^(p+1): C2 at first touch needs p >= 1 (the kernel's onset band
+            # smooths the rest).
+            if not (math.isfinite(v) and 1.0 <= v <= 6.0):
+                raise ValueError(f"{name} must be in [1, 6], got {v!r}")
+        if not (0.0 < self.angle_line_deg < self.angle_point_deg < 90.0):
+            raise ValueError("need 0 < angle_line_deg < angle_point_deg < 90")
+
+    # -- constructors ----------------------------------------------------------------------
+    @classmethod
+    def from_json(cls, path: str | Path | None = None) -> RadialComplianceLaw:
+        """The calibrated law (default: the file shipped in ``tightknot/data``)."""
+        if path is None:
+            text = _LAW_FILE.read_text()
+            where = "tightknot/data/contact_law.json"
+        else:
+            text = Path(path).read_text()
+            where = str(path)
+        d = json.loads(text)
+        keys = {f for f in cls.__dataclass_fields__}
+        kw = {k: float(v) for k, v in d.items() if k in keys and isinstance(v, (int, float))}
+        if "k_patch" not in kw and "k_patch_axial" in d:
+            kw["k_patch"] = float(d["k_patch_axial"])
+            kw["p_patch"] = float(d["p_patch_axial"])
+        date = d.get("provenance", {}).get("date", "?")
+        return cls(**kw, source=f"FEM calibration {where} ({date})")
+
+    @classmethod
+    def hertz(cls) -> RadialComplianceLaw:
+        """Small-strain elastic contact of cylinders as power laws: the plane-strain line
+        contact (Johnson 1985 eqs. 4.45, 5.36, fitted over w/D in [1e-3, 0.15]) and Hertz
+        crossed cylinders F = (4/3) E* sqrt(R) d^(3/2) (Johnson 1985 eq. 4.22; rigid
+        indenter, E* = E/(1 - nu^2), nu = 1/2); values of the shipped calibration file."""
+        d = json.loads(_LAW_FILE.read_text())
+        h = d["hertz"]
+        return cls(k_line=h["k_line"], p_line=h["p_line"], k_point=h["k_point"],
+                   p_point=h["p_point"], k_width=h["k_width"], p_width=h["p_width"],
+                   k_pmax_line=h["k_pmax_line"], p_pmax_line=h["p_pmax_line"],
+                   k_pmax_point=h["k_pmax_point"], p_pmax_point=h["p_pmax_point"],
+                   k_patch=h["k_patch"], p_patch=h["p_patch"],
+                   source="small-strain Hertz (Johnson 1985)")
+
+    def rigid_tube(self, stiffness: float = 1e3) -> RadialComplianceLaw:
+        """A rigid-tube version: ``stiffness`` times stiffer, quadratic-energy onset."""
+        return replace(self, k_line=self.k_line * stiffness, k_point=self.k_point * stiffness,
+                       p_line=max(self.p_line, 1.0), p_point=max(self.p_point, 1.0),
+                       rigid=True, source=f"rigid tube ({stiffness:g} x {self.source})")
+
+    def as_dict(self) -> dict:
+        """Parameters as a JSON-ready dict."""
+        return asdict(self)
+
+    # -- pair energies (SI), used by the kernels' constants and by tests -------------------
+    def line_energy_coefficient(self, youngs_modulus: float, diameter: float) -> float:
+        """K_line [J/m^(1+m)] of ``e_line(delta) = K delta^m``, m = p_line + 1."""
+        m = self.p_line + 1.0
+        return 2.0 * self.k_line * youngs_modulus * diameter**2 * (2 * diameter) ** (-m) / m
+
+    def point_energy_coefficient(self, youngs_modulus: float, diameter: float) -> float:
+        """K_point [J/m^m] of ``e_point(delta) = K delta^m``, m = p_point + 1."""
+        m = self.p_point + 1.0
+        return 2.0 * self.k_point * youngs_modulus * diameter**3 * (2 * diameter) ** (-m) / m
+
+    def line_force_per_length(self, delta: np.ndarray, youngs_modulus: float,
+                              diameter: float) -> np.ndarray:
+        """Pair force per unit length [N/m] of identical parallel rods at overlap delta [m]."""
+        w = np.maximum(np.asarray(delta, dtype=float), 0.0) / 2.0
+        return self.k_line * youngs_modulus * diameter * (w / diameter) ** self.p_line
+
+    def point_force(self, delta: np.ndarray, youngs_modulus: float,
+                    diameter: float) -> np.ndarray:
+        """Pair force [N] of identical crossing rods at overlap delta [m]."""
+        w = np.maximum(np.asarray(delta, dtype=float), 0.0) / 2.0
+        return self.k_point * youngs_modulus * diameter**2 * (w / diameter) ** self.p_point
+
+    def kernel_constants(self, youngs_modulus: float, diameter: float) -> tuple[float, ...]:
+        """(C_line, alpha_line, C_point, alpha_point) of the pair kernel C h(x)^alpha
+        [J/m^(2+alpha)] for rods of rest diameter D (R = D): see the module docstring."""
+        r = diameter  # R = r_i + r_j = D for identical rods
+        m_l = self.p_line + 1.0
+        a_l = m_l - 0.5
+        beta = math.sqrt(math.pi) * math.gamma(a_l + 1.0) / math.gamma(a_l + 1.5)
+        c_l = self.line_energy_coefficient(youngs_modulus, diameter) * (2 * r) ** -0.5 / beta
+        m_p = self.p_point + 1.0
+        a_p = m_p - 1.0
+        c_p = self.point_energy_coefficient(youngs_modulus, diameter) * m_p / (math.pi * 2 * r)
+        return c_l, a_l, c_p, a_p
+
+    # -- section outputs (per side, from the calibrated fits) -----------------------------
+    def half_width(self, w: np.ndarray, diameter: float) -> np.ndarray:
+        """Line-contact half-width b [m] at per-side approach w [m]."""
+        return self._power(self.k_width, self.p_width, w, diameter) * diameter
+
+    def contact_fraction(self, w: np.ndarray, diameter: float) -> np.ndarray:
+        """Fraction of the perimeter in contact on one side at approach w [m]."""
+        return np.minimum(self._power(self.c_lc, self.p_lc, w, diameter), 0.5)
+
+    def peak_pressure_line(self, w: np.ndarray, diameter: float) -> np.ndarray:
+        """Peak line-contact pressure over E at approach w [m]."""
+        return self._power(self.k_pmax_line, self.p_pmax_line, w, diameter)
+
+    def peak_pressure_point(self, w: np.ndarray, diameter: float) -> np.ndarray:
+        """Peak point-contact pressure over E at approach w [m]."""
+        return self._power(self.k_pmax_point, self.p_pmax_point, w, diameter)
+
+    def area_factor(self, w: np.ndarray, diameter: float) -> np.ndarray:
+        """Section area factor 1 - k_area (w/D)^p_area under a squeeze w [m] per side."""
+        return np.maximum(1.0 - self._power(self.k_area, self.p_area, w, diameter), 0.0)
+
+    @staticmethod
+    def _power(k: float, p: float, w: np.ndarray, diameter: float) -> np.ndarray:
+        w = np.maximum(np.asarray(w, dtype=float), 0.0)
+        return k * (w / diameter) ** p
