@@ -314,9 +314,11 @@ def contact_pair_kernel(
             s = wp.dot(r, r)
             x = (R * R - s) / (f64(2.0) * R)
             xmax = wp.max(xmax, x)
-            if x <= -eps:
+            if x <= f64(0.0):
                 continue
-            hv = positive_part(x, eps)
+            # Onset band [0, 2 eps] inside the contact: exactly zero while d >= R (surfaces
+            # apart or just touching), C2 after; shifts the law by eps (1e-4 R by default).
+            hv = positive_part(x - eps, eps)
             Gl = power_of_ramp(hv, C_l, al_l)
             Gp = power_of_ramp(hv, C_p, al_p)
             Psi = A * Gl[0] + B * Gp[0]

@@ -33,8 +33,14 @@ is chosen because its integrals are exact powers of the same variable:
 
 The two are blended by crossing angle (Meier, Popp, Wall 2016, "A unified approach for
 beam-to-beam contact", CMAME 315:972: line contact below ``angle_line``, point contact above
-``angle_point``, a C2 blend between). ``h`` is a C2 positive part with a band ``smoothing``
-(relative to R) so that the energy is C2 everywhere.
+``angle_point``, a C2 blend between). ``h(x) = H(x - eps)`` with H a C2 positive part of
+onset band [-eps, eps], eps = ``smoothing`` x R: the energy is C2 everywhere and exactly zero
+while d >= R (h(x) = x - eps beyond the band: the law is shifted by eps, 1e-4 R by default).
+
+Resolution: the contact zone of a pair at overlap x has half-length sqrt(2 R x) along the
+strands; the Gauss quadrature reproduces the laws within 1 to 3 % when it spans two Gauss
+spacings or more (measured with 2 points on edges of D/4: 2 % at x >= 0.05 D, 5 % at
+x = 0.01 D).
 """
 
 from __future__ import annotations
@@ -88,7 +94,7 @@ class RadialComplianceLaw:
     p_area: float = 1.2
     angle_line_deg: float = 15.0
     angle_point_deg: float = 35.0
-    smoothing: float = 1e-3
+    smoothing: float = 1e-4
     rigid: bool = False
     source: str = "parameters"
 

@@ -1,0 +1,178 @@
+"""The self-contact layer: derivatives, the calibrated law on straight strands, the
+exclusion window, the step bound, and refusing a start that already intersects itself."""
+
+import math
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from tightknot.rods.builder import RodBuilder
+from tightknot.rods.contact import ContactLayer, SelfIntersectionError
+from tightknot.rods.contact_law import RadialComplianceLaw
+from tightknot.rods.material import Material
+
+D, E = 0.0085, 1.25e6
+LAW = RadialComplianceLaw.from_json()
+
+
+def two_rods(angle_deg: float, distance: float, n: int = 81, length: float = 20 * D,
+             noise: float = 0.0, seed: int = 0):
+    """Rod 0 along x; rod 1 crossing it at ``angle_deg`` in a plane ``distance`` above."""
+    rng = np.random.default_rng(seed)
+    s = np.linspace(-length / 2, length / 2, n)
+    th = math.radians(angle_deg)
+    b = RodBuilder(twist=False)
+    b.add_rod(np.c_[s, 0 * s, 0 * s], D, Material(E, 0.5, 1160.0))
+    b.add_rod(np.c_[s * math.cos(th), s * math.sin(th), 0 * s + distance]
+              + noise * D * rng.standard_normal((n, 3)), D, Material(E, 0.5, 1160.0))
+    return b.finalize()
+
+
+def distance_for_overlap(x_over_d: float) -> float:
+    # The law's variable is x = (R^2 - d^2)/(2R) (contact_law docstring); R = D here.
+    return math.sqrt(D * D - 2 * D * x_over_d * D)
+
+
+@pytest.mark.parametrize("angle, gap", [(90.0, 0.9), (60.0, 0.7), (25.0, 0.8),
+                                        (5.0, 0.85), (0.5, 0.95)])
+def test_gradient_and_hessian_match_finite_differences(angle: float, gap: float) -> None:
+    # Crossing (90, 60), the line-to-point blend (25), near parallel (5, 0.5 deg); rest
+    # lengths 3 % longer than the edges, so the sections are compressed and their radii
+    # r0 (l/l_bar)^-nu enter the derivatives.
+    m = two_rods(angle, gap * D, n=6, length=0.03, noise=0.01)
+    cl = ContactLayer(m, LAW, gauss_points=2)
+    x0 = m.vertex_initial_position.copy()
+    rest = m.edge_rest_length * 1.03
+    e0, g0, coo = cl.evaluate(x0, rest, True, True)
+    assert e0 > 0 and len(cl.last_pairs) > 0
+    dofs = m.position_dofs.ravel()
+    h_full = sp.coo_matrix((coo[2], (coo[0], coo[1])), shape=(m.dof_count,) * 2).toarray()
+    hess = h_full[np.ix_(dofs, dofs)]
+    n = dofs.size
+    step = 1e-7 * D  # central differences: truncation ~ step^2, round-off ~ 1e-16 E / step
+    gfd = np.zeros(n)
+    hfd = np.zeros((n, n))
+    changes = []
+    for k in range(n):
+        dx = np.zeros(n)
+        dx[k] = step
+        ep, gp, _ = cl.evaluate(x0 + dx.reshape(-1, 3), rest, True, False)
+        em, gm, _ = cl.evaluate(x0 - dx.reshape(-1, 3), rest, True, False)
+        gfd[k] = (ep - em) / (2 * step)
+        hfd[k] = (gp - gm).ravel() / (2 * step)
+        changes.append(abs(ep - em))
+    # Guard: the perturbations do move the energy well above its round-off.
+    assert max(changes) > 1e6 * np.finfo(float).eps * e0
+    g = g0.ravel()
+    # 1e-6 relative (the issue's target); measured 1e-9..2e-9.
+    assert np.abs(gfd - g).max() <= 1e-6 * np.abs(g).max()
+    assert np.abs(hfd - hess).max() <= 1e-6 * np.abs(hess).max()
+    assert np.abs(hess - hess.T).max() <= 1e-12 * np.abs(hess).max()
+
+
+@pytest.mark.parametrize("x_over_d", [0.05, 0.1, 0.2])
+def test_parallel_strands_follow_the_line_law(x_over_d: float) -> None:
+    # Two parallel straight rods held at the distance of overlap x: the contact force per
+    # unit length at mid-rod is the line law's f = de_line/dd. Quadrature error with 2 Gauss
+    # points on edges of D/4: measured within 2.1 % for x >= 0.05 D; 3 % bound.
+    d = distance_for_overlap(x_over_d)
+    m = two_rods(0.0, d)
+    cl = ContactLayer(m, LAW, gauss_points=2)
+    _, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
+    h = m.edge_rest_length[0]
+    f_model = -g[m.rods[1].vertex_start + 40, 2] / h
+    x = x_over_d * D - LAW.smoothing * D  # the law acts on x - eps (contact_law docstring)
+    mm = LAW.p_line + 1
+    f_law = LAW.line_energy_coefficient(E, D) * mm * x ** (mm - 1) * d / D
+    assert f_model == pytest.approx(f_law, rel=0.03)
+
+
+@pytest.mark.parametrize("x_over_d", [0.05, 0.1, 0.2])
+def test_crossed_strands_follow_the_point_law(x_over_d: float) -> None:
+    # Two rods crossing at 90 degrees: the total contact force is the point law's
+    # F = de_point/dd; measured within 2.7 % with 2 Gauss points; 4 % bound.
+    d = distance_for_overlap(x_over_d)
+    m = two_rods(90.0, d)
+    cl = ContactLayer(m, LAW, gauss_points=2)
+    _, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
+    f_model = -g[m.rods[1].vertex_slice, 2].sum()
+    x = x_over_d * D - LAW.smoothing * D  # the law acts on x - eps (contact_law docstring)
+    mp = LAW.p_point + 1
+    f_law = LAW.point_energy_coefficient(E, D) * mp * x ** (mp - 1) * d / D
+    assert f_model == pytest.approx(f_law, rel=0.04)
+
+
+def test_no_contact_beyond_the_diameter() -> None:
+    m = two_rods(30.0, 1.001 * D)
+    cl = ContactLayer(m, LAW)
+    e, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
+    assert e == 0.0 and np.abs(g).max() == 0.0
+
+
+def test_tight_u_turn_does_not_touch_itself() -> None:
+    # A hairpin of centerline radius D/2 (the tightest bend a tube allows): its straight legs
+    # are D apart, touching only at the limit. No point pair outside the exclusion window is
+    # closer than D, so the energy must be zero.
+    n_arc, r = 60, D / 2
+    phi = np.linspace(-math.pi / 2, math.pi / 2, n_arc)
+    arc = np.c_[r * np.cos(phi), r * np.sin(phi), 0 * phi]
+    legs = np.linspace(-6 * D, 0, 80)[:-1]
+    lower = np.c_[legs, -r + 0 * legs, 0 * legs]
+    upper = np.c_[legs[::-1], r + 0 * legs, 0 * legs]
+    pts = np.vstack([lower, arc, upper])
+    b = RodBuilder(twist=False)
+    b.add_rod(pts, D, Material(E, 0.5, 1160.0))
+    m = b.finalize()
+    cl = ContactLayer(m, LAW)
+    e, _, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, False, False)
+    assert e == 0.0
+    # The same hairpin squeezed to legs 0.9 D apart does touch (the check can fail).
+    squeezed = pts.copy()
+    squeezed[:, 1] *= 0.9
+    e2, _, _ = cl.evaluate(squeezed, m.edge_rest_length, False, False)
+    assert e2 > 0.0
+
+
+def test_step_bound_prevents_passing_through() -> None:
+    # Rod 1 crosses 1.2 D above rod 0; a step that moves it 3 D down would pass through.
+    m = two_rods(90.0, 1.2 * D, n=21, length=6 * D)
+    cl = ContactLayer(m, LAW, hard_fraction=0.1)
+    x = m.vertex_initial_position
+    dx = np.zeros_like(x)
+    dx[m.rods[1].vertex_slice, 2] = -3.0 * D
+    alpha = cl.max_step(x, dx)
+    # The bound keeps the segments at least the hard limit apart: at alpha the gap is
+    # 1.2 D - 3 D alpha >= 0.1 D, i.e. alpha <= 1.1/3; and it is not needlessly small.
+    assert 0.0 < alpha <= 1.1 / 3 + 1e-12
+    assert alpha >= 0.99 * 1.1 / 3
+    dist, _, _ = cl.min_distance(x + alpha * dx)
+    assert dist >= 0.1 * D * (1 - 1e-9)
+    # A step that moves away is not limited.
+    assert cl.max_step(x, -dx) == 1.0
+
+
+def test_start_that_intersects_itself_is_refused_with_arc_lengths() -> None:
+    m = two_rods(90.0, 0.05 * D, n=21, length=6 * D)
+    cl = ContactLayer(m, LAW, hard_fraction=0.1)
+    with pytest.raises(SelfIntersectionError, match=r"arc lengths .* m apart, below"):
+        cl.check_no_intersection(m.vertex_initial_position)
+
+
+def test_candidate_buffer_grows_instead_of_dropping() -> None:
+    # Start with a capacity of 1: the buffer must grow and give the same energy.
+    m = two_rods(10.0, 0.9 * D, n=41, length=10 * D)
+    small = ContactLayer(m, LAW, initial_capacity=1)
+    big = ContactLayer(m, LAW, initial_capacity=100000)
+    e1, _, _ = small.evaluate(m.vertex_initial_position, m.edge_rest_length, False, False)
+    e2, _, _ = big.evaluate(m.vertex_initial_position, m.edge_rest_length, False, False)
+    assert e1 == e2 and e1 > 0
+
+
+def test_law_parameters_are_validated() -> None:
+    with pytest.raises(ValueError, match="p_line"):
+        RadialComplianceLaw(k_line=1.0, p_line=0.5, k_point=1.0, p_point=1.5)
+    with pytest.raises(ValueError, match="k_point"):
+        RadialComplianceLaw(k_line=1.0, p_line=1.2, k_point=-1.0, p_point=1.5)
+    with pytest.raises(ValueError, match="gauss_points"):
+        ContactLayer(two_rods(0.0, 2 * D, n=5), LAW, gauss_points=5)
