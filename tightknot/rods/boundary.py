@@ -68,6 +68,7 @@ class BoundaryConditions:
         self._clamps: list[_Clamp] = []
         self._pins: list[_Pin] = []
         self._fixed_twist: list[int] = []
+        self._components: list[tuple[int, tuple[int, ...]]] = []
         self._forces: list[tuple[int, PathVec]] = []
         self._rest_scale: list[tuple[np.ndarray, Callable[[float], float]]] = []
 
@@ -123,6 +124,19 @@ class BoundaryConditions:
         self._pins.append(_Pin(v, _as_path_vec(translation, "translation"), x0))
         return self
 
+    def fix_components(
+        self, rod: int = 0, vertex: int = 0, components: tuple[int, ...] = (1, 2)
+    ) -> BoundaryConditions:
+        """Fix some coordinates (0 = x, 1 = y, 2 = z) of a vertex at their initial values:
+        a vertex sliding along an axis, or a gauge that removes a rigid rotation."""
+        v = self._vertex(rod, vertex)
+        comps = tuple(int(c) for c in components)
+        if not comps or any(c not in (0, 1, 2) for c in comps):
+            raise ValueError(
+                f"components must be a non-empty subset of (0, 1, 2), got {components}")
+        self._components.append((v, comps))
+        return self
+
     def fix_twist(self, rod: int = 0, edge: int = 0) -> BoundaryConditions:
         """Fix the twist angle of one edge (e.g. no end twist of a pulled knot)."""
         info = self._rod(rod)
@@ -174,6 +188,8 @@ class BoundaryConditions:
             mask[m.vertex_dof[p.vertex] + np.arange(3)] = True
         for e in self._fixed_twist:
             mask[m.edge_dof[e]] = True
+        for v, comps in self._components:
+            mask[m.vertex_dof[v] + np.array(comps)] = True
         return mask
 
     def edge_rest_length(self, t: float) -> np.ndarray:

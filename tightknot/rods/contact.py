@@ -78,6 +78,14 @@ class ContactLayer:
             in the module docstring).
         hard_fraction: hard limit of the centerline distance over the pair's rest diameter;
             a Newton step never brings two non-local segments closer.
+        core_fraction: a hard-core barrier adds to the law over a band of width
+            (core_fraction - hard_fraction) D above the distance where it diverges,
+            hard_fraction D + 0.58 l (l the longer rest edge: every polyline point is within
+            0.29 l of a Gauss point, so the barrier stops two segments before the step bound
+            would). An IPC barrier (Li et al. 2020), zero outside the band and C2; with
+            edges below 0.3 D it acts only beyond the calibrated range (pair overlap 0.3 D),
+            and lets Newton steps stop short of the limit instead of jamming against it.
+        core_stiffness: the barrier's stiffness over E D (energy per length^2).
         initial_capacity: first size of the candidate-pair buffer (grows on demand).
     """
 
@@ -89,7 +97,9 @@ class ContactLayer:
         law: RadialComplianceLaw | None = None,
         gauss_points: int = 2,
         exclusion_factor: float = math.pi / 2,
-        hard_fraction: float = 0.1,
+        hard_fraction: float = 0.05,
+        core_fraction: float = 0.25,
+        core_stiffness: float = 1.0,
         initial_capacity: int = 1024,
     ) -> None:
         init_warp()
@@ -97,8 +107,11 @@ class ContactLayer:
             raise ValueError(f"gauss_points must be 1, 2 or 3, got {gauss_points}")
         if not (math.isfinite(exclusion_factor) and exclusion_factor >= math.pi / 2):
             raise ValueError(f"exclusion_factor must be >= pi/2, got {exclusion_factor}")
-        if not (0.0 < hard_fraction < 1.0):
-            raise ValueError(f"hard_fraction must be in (0, 1), got {hard_fraction}")
+        if not (0.0 < hard_fraction < core_fraction < 0.7):
+            raise ValueError("need 0 < hard_fraction < core_fraction < 0.7 (the calibrated "
+                             f"range ends at d = 0.7 D), got {hard_fraction}, {core_fraction}")
+        if not (math.isfinite(core_stiffness) and core_stiffness > 0):
+            raise ValueError(f"core_stiffness must be finite and > 0, got {core_stiffness}")
         self.model = model
         self.law = law or RadialComplianceLaw.from_json()
         self.hard_fraction = float(hard_fraction)
@@ -115,6 +128,7 @@ class ContactLayer:
         self._edge_rod = wp.array(m.edge_rod, dtype=wp.int32, device=dev)
         self._rod_closed = wp.array([int(r.closed) for r in m.rods], dtype=wp.int32, device=dev)
         self._radius0 = wp.array(m.edge_radius, dtype=f64, device=dev)
+        self._law_radius = wp.array(m.edge_radius, dtype=f64, device=dev)
         self._poisson = wp.array(nu, dtype=f64, device=dev)
         self._modulus = wp.array(emod, dtype=f64, device=dev)
         xi, w = _GAUSS[gauss_points]
@@ -127,6 +141,7 @@ class ContactLayer:
             law_.k_line, law_.p_line + 1.0, beta, law_.k_point, law_.p_point + 1.0,
             math.cos(math.radians(law_.angle_line_deg)) ** 2,
             math.cos(math.radians(law_.angle_point_deg)) ** 2, law_.smoothing,
+            core_fraction, hard_fraction, core_stiffness,
         ], dtype=f64, device=dev)
         self._exclusion = wp.array(exclusion_factor * diam, dtype=f64, device=dev)
         self._hard = wp.array(hard_fraction * diam, dtype=f64, device=dev)
@@ -134,10 +149,34 @@ class ContactLayer:
         # lam >= 0.5 is at most 2^nu r0 <= 1.42 r0), so half the pair range is covered.
         self._margin = wp.array(1.5 * m.edge_radius, dtype=f64, device=dev)
         self._zero_dx = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
+        self.radius_scale = 1.0
+        #: Optional schedule t -> contact radius scale along a load path (inflation).
+        self.radius_schedule = None
         self._capacity = int(initial_capacity)
         self._alloc(self._capacity)
         self.last_pairs = np.zeros((0, 2), dtype=np.int32)
         self.last_overlap = np.zeros(0)
+
+    # -- load path -------------------------------------------------------------------------
+    def set_radius_scale(self, scale: float) -> None:
+        """Scale the contact radii of every edge (the tube inflated or thinned), (0, 1].
+
+        Only the geometry shrinks: the law keeps the stiffness of the full rod, so a thin
+        tube is not squeezed through by the bending forces of the full one.
+        """
+        if not (math.isfinite(scale) and 0.0 < scale <= 1.0):
+            raise ValueError(f"radius scale must be in (0, 1], got {scale!r}")
+        self.radius_scale = float(scale)
+        dev = self.device
+        r = self.model.edge_radius * scale
+        self._radius0 = wp.array(r, dtype=wp.float64, device=dev)
+        self._hard = wp.array(self.hard_fraction * 2.0 * r, dtype=wp.float64, device=dev)
+        self._margin = wp.array(1.5 * r, dtype=wp.float64, device=dev)
+
+    def set_load(self, t: float) -> None:
+        """Follow the radius schedule (if any) at load parameter t."""
+        if self.radius_schedule is not None:
+            self.set_radius_scale(float(self.radius_schedule(t)))
 
     # -- buffers and detection -------------------------------------------------------------
     def _alloc(self, capacity: int) -> None:
@@ -204,8 +243,8 @@ class ContactLayer:
         wrest = wp.array(np.ascontiguousarray(rest), dtype=wp.float64, device=dev)
         wp.launch(ck.contact_pair_kernel, dim=npairs, device=dev,
                   inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, self._radius0,
-                          self._poisson, self._modulus, self._gxi, self._gw, self._law, wx,
-                          pairs, wrest, arcs, rod_len, self._exclusion,
+                          self._law_radius, self._poisson, self._modulus, self._gxi, self._gw,
+                          self._law, wx, pairs, wrest, arcs, rod_len, self._exclusion,
                           int(want_grad or want_hess), int(want_hess)],
                   outputs=[energy, grad, hess, overlap])
         e = float(energy.numpy().sum())
@@ -246,8 +285,8 @@ class ContactLayer:
         return float(np.clip(alpha.numpy().min(), 0.0, 1.0))
 
     def _half_hard(self) -> wp.array:
-        return wp.array(0.5 * self.hard_fraction * self.edge_diameter, dtype=wp.float64,
-                        device=self.device)
+        return wp.array(0.5 * self.hard_fraction * self.edge_diameter * self.radius_scale,
+                        dtype=wp.float64, device=self.device)
 
     def check_no_intersection(self, x: np.ndarray) -> None:
         """Refuse positions whose non-local segments are closer than the hard limit,
@@ -267,8 +306,8 @@ class ContactLayer:
                   outputs=[alpha, dist])
         d = dist.numpy()
         pr = pairs.numpy()
-        hard = np.maximum(self.hard_fraction * self.edge_diameter[pr[:, 0]],
-                          self.hard_fraction * self.edge_diameter[pr[:, 1]])
+        dh = self.hard_fraction * self.edge_diameter * self.radius_scale
+        hard = np.maximum(dh[pr[:, 0]], dh[pr[:, 1]])
         bad = np.flatnonzero(d < hard)
         if bad.size:
             k = bad[np.argmin(d[bad] / hard[bad])]

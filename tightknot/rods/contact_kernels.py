@@ -73,6 +73,30 @@ def power_of_ramp(hv: wp.vec3d, coef: wp.float64, alpha: wp.float64) -> wp.vec3d
 
 
 @wp.func
+def hard_core(s: wp.float64, rho_hard: wp.float64, rho_core: wp.float64,
+              k: wp.float64) -> wp.vec3d:
+    """Barrier b = -k (y - yc)^2 ln(y/yc), y = rho - rho_hard, yc = rho_core - rho_hard, as a
+    function of s = rho^2, with db/ds and d2b/ds2 (zero for rho >= rho_core)."""
+    rho = wp.sqrt(s)
+    if rho >= rho_core:
+        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
+    if rho <= rho_hard:
+        # Outside the barrier's domain: an energy no line search accepts.
+        return wp.vec3d(f64(1.0e300), f64(0.0), f64(0.0))
+    y = rho - rho_hard
+    yc = rho_core - rho_hard
+    lg = wp.log(y / yc)
+    dy = y - yc
+    b = -k * dy * dy * lg
+    b1 = -k * (f64(2.0) * dy * lg + dy * dy / y)
+    b2 = -k * (f64(2.0) * lg + f64(4.0) * dy / y - dy * dy / (y * y))
+    # Chain rule to s = rho^2: d/ds = (1/(2 rho)) d/drho.
+    bs = b1 / (f64(2.0) * rho)
+    bss = (b2 - b1 / rho) / (f64(4.0) * s)
+    return wp.vec3d(b, bs, bss)
+
+
+@wp.func
 def arc_separation(sa: wp.float64, sb: wp.float64, same_rod: int, closed: int,
                    rod_length: wp.float64) -> wp.float64:
     if same_rod == 0:
@@ -187,6 +211,7 @@ def contact_pair_kernel(
     edge_rod: wp.array(dtype=wp.int32),
     rod_closed: wp.array(dtype=wp.int32),
     edge_radius0: wp.array(dtype=wp.float64),
+    edge_law_radius: wp.array(dtype=wp.float64),
     edge_poisson: wp.array(dtype=wp.float64),
     edge_modulus: wp.array(dtype=wp.float64),
     gauss_xi: wp.array(dtype=wp.float64),
@@ -223,7 +248,8 @@ def contact_pair_kernel(
     lb = wp.length(eb)
     ta = ea / la
     tb = eb / lb
-    # Law parameters: [k_line, m_line, beta_line, k_point, m_point, q_line, q_point, eps].
+    # Law parameters: [k_line, m_line, beta_line, k_point, m_point, q_line, q_point, eps,
+    #                  core_fraction, hard_fraction, core_stiffness].
     k_l = law[0]
     m_l = law[1]
     beta_l = law[2]
@@ -232,8 +258,12 @@ def contact_pair_kernel(
     q_line = law[5]
     q_point = law[6]
     eps_rel = law[7]
-    # Pair constants from the rest diameter D = r0a + r0b and the harmonic-mean modulus.
-    d0 = edge_radius0[a] + edge_radius0[b]
+    core_frac = law[8]
+    hard_frac = law[9]
+    core_k = law[10]
+    # Pair constants from the rod's rest diameter D = r_a + r_b (``edge_law_radius``: an
+    # inflating tube keeps the stiffness of the full rod) and the harmonic-mean modulus.
+    d0 = edge_law_radius[a] + edge_law_radius[b]
     emod = f64(2.0) * edge_modulus[a] * edge_modulus[b] / (edge_modulus[a] + edge_modulus[b])
     two_d = f64(2.0) * d0
     C_l = f64(2.0) * k_l * emod * d0 * d0 * wp.pow(two_d, -m_l) / m_l * wp.pow(
@@ -279,6 +309,17 @@ def contact_pair_kernel(
         B1 = xi1 * sn + xi * s1
         B2 = xi2 * sn + f64(2.0) * xi1 * s1 + xi * s2
     eps = eps_rel * d0
+    # Hard core (IPC barrier, Li et al. 2020, eq. 6, shifted to the hard limit): zero for
+    # rho >= core, C2 there, infinite at the hard limit that the step bound guards.
+    # Every point of a polyline is within 0.29 l of one of its Gauss points (2 per edge:
+    # 0.577 l apart inside an edge, 0.42 l across a vertex; 3 per edge: closer), so the
+    # barrier diverges at rho_hard = hard + 0.58 l_max: it stops two segments before their
+    # distance reaches the step bound's hard limit, whatever Gauss points they hold.
+    dgeo = edge_radius0[a] + edge_radius0[b]
+    lmax = wp.max(edge_rest_length_in[a], edge_rest_length_in[b])
+    rho_hard = hard_frac * dgeo + f64(0.58) * lmax
+    rho_core = rho_hard + (core_frac - hard_frac) * dgeo
+    kcore = core_k * emod * d0
     ng = gauss_xi.shape[0]
     ra_ = edge_rod[a]
     same = int(0)
@@ -322,6 +363,8 @@ def contact_pair_kernel(
             Gl = power_of_ramp(hv, C_l, al_l)
             Gp = power_of_ramp(hv, C_p, al_p)
             Psi = A * Gl[0] + B * Gp[0]
+            bv = hard_core(s, rho_hard, rho_core, kcore)
+            Psi = Psi + bv[0]
             wgt = gauss_w[gi] * gauss_w[hi] * wex
             P = la * lb
             energy += wgt * P * Psi
@@ -336,9 +379,9 @@ def contact_pair_kernel(
             x_R = f64(0.5) + s / (f64(2.0) * R * R)
             x_sR = f64(0.5) / (R * R)
             x_RR = -s / (R * R * R)
-            Ps = Px * x_s
+            Ps = Px * x_s + bv[1]
             PR = Px * x_R
-            Pss = Pxx * x_s * x_s
+            Pss = Pxx * x_s * x_s + bv[2]
             PsR = Pxx * x_s * x_R + Px * x_sR
             PRR = Pxx * x_R * x_R + Px * x_RR
             Psq = Pxq * x_s

@@ -3,7 +3,9 @@
 Each iteration solves ``(H + mu D) d = -g`` with D the absolute diagonal of H (a
 Levenberg-Marquardt shift, Nocedal & Wright 2006 sec. 3.4) raised whenever the Hessian
 proves not positive definite along the step (``d.H d <= 0``), the step is not a descent
-direction, or the factorization fails; the step is then cut to the largest fraction the
+direction, or the factorization fails, and adapted like a trust region after each step
+(grown when the step had to be cut or overshot, relaxed after good full steps); the step is
+cut to the largest fraction the
 problem allows (no passing through, from the contact layer) and a backtracking Armijo line
 search on the total potential follows (Nocedal & Wright Alg. 3.1).
 
@@ -52,7 +54,8 @@ class NewtonOptions:
         max_iterations: iteration limit.
         armijo: sufficient-decrease constant of the line search.
         max_backtracks: line-search halvings before the shift is raised instead.
-        shift_initial: first relative shift mu when one is needed.
+        shift_initial: first relative shift mu when the Hessian is not positive definite.
+        shift_trust: first relative shift when steps overshoot (trust-region damping).
         shift_max: beyond this shift the solve gives up.
     """
 
@@ -62,10 +65,12 @@ class NewtonOptions:
     armijo: float = 1e-4
     max_backtracks: int = 30
     shift_initial: float = 1e-8
+    shift_trust: float = 1e-3
     shift_max: float = 1e8
 
     def __post_init__(self) -> None:
-        for name in ("residual_tol", "step_tol", "armijo", "shift_initial", "shift_max"):
+        for name in ("residual_tol", "step_tol", "armijo", "shift_initial", "shift_trust",
+                     "shift_max"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v!r}")
@@ -119,7 +124,7 @@ def newton_solve(
         diag = np.maximum(diag, 1e-12 * (diag.max() if diag.size else 1.0))
         while not accepted:
             d = _shifted_direction(h, g, mu, diag)
-            if d is None or not _acceptable(d, g, h):
+            if d is None or not _acceptable(d, g, h, mu, diag):
                 mu = opt.shift_initial if mu == 0.0 else mu * 10.0
                 if mu > opt.shift_max:
                     problem.accept(u)
@@ -152,16 +157,25 @@ def newton_solve(
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
                                         history)
         du = alpha * d
+        predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ (h @ d)))
         u = u + du
         step = problem.step_norm(du)
         problem.accept(u)
+        e_old = energy
         energy, g, h = problem.evaluate(u, True, True)
         if not (math.isfinite(energy) and np.isfinite(g).all()):
             return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
         res = problem.residual_norm(g)
         history.append(res)
-        # Relax the shift after a successful step (trust grows back toward pure Newton).
-        mu = 0.0 if mu <= opt.shift_initial else mu / 100.0
+        # Adapt the shift like a trust region (Nocedal & Wright Alg. 4.1 with the
+        # Levenberg-Marquardt step): a step that had to be cut, or whose actual decrease is
+        # a small part of the quadratic model's, means the model is trusted too far: damp
+        # more; a full step that the model predicted well lets the shift decay to zero.
+        ratio = (e_old - energy) / predicted if predicted > 0 else 1.0
+        if alpha < 0.5 or ratio < 0.25:
+            mu = max(4.0 * mu, opt.shift_trust)
+        elif alpha == 1.0 and ratio > 0.75:
+            mu = 0.0 if mu <= opt.shift_trust else mu / 4.0
         if res <= opt.residual_tol:
             return NewtonResult(True, it, res, step, energy, "converged", history)
         if step <= opt.step_tol:
@@ -180,9 +194,12 @@ def _shifted_direction(
     return d if np.isfinite(d).all() else None
 
 
-def _acceptable(d: np.ndarray, g: np.ndarray, h: sp.csc_matrix) -> bool:
-    # A descent direction along which the Hessian has positive curvature; otherwise the
-    # Hessian is not positive definite there and the shift must grow.
+def _acceptable(d: np.ndarray, g: np.ndarray, h: sp.csc_matrix, mu: float,
+                diag: np.ndarray) -> bool:
+    # A descent direction along which the shifted model (the one the step minimises) has
+    # positive curvature; otherwise that model is not positive definite there and the shift
+    # must grow. The unshifted Hessian may stay indefinite (a loose knot is floppy): with
+    # the shift the step is a damped descent step, and the line search judges it.
     slope = float(g @ d)
-    curv = float(d @ (h @ d))
+    curv = float(d @ (h @ d)) + mu * float(np.sum(diag * d * d))
     return slope < 0.0 and curv > 0.0

@@ -1,0 +1,220 @@
+"""Tying and tightening the study's knots: the load paths that solve a :class:`KnotScene`.
+
+Phase 1 (``tighten``): the rest length shrinks from the scene's start length to L0; an open
+knot's end slides freely along the pull axis under a small tension (``hold_force``), so
+the tails feed the knot as it closes. Phase 2 (``pull``, open knots): the sliding end is
+pulled along the axis by a dead force growing geometrically to the target, or moved to a
+target end-to-end distance. After every converged load step the knot type is checked
+(Alexander polynomial); a change stops the run as failed (physics.md sec. 2: a knot that
+passed through itself has failed).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tightknot.knots import topology
+from tightknot.knots.scenes import KnotScene, bending_force_scale, end_vertex
+from tightknot.rods.boundary import BoundaryConditions
+from tightknot.solvers.newton import NewtonOptions, newton_solve
+from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord, solve_static
+from tightknot.solvers.system import RodSystem
+
+StepHook = Callable[[str, RodSystem, StepRecord], None]
+
+
+@dataclass
+class TieResult:
+    """Outcome of tying a knot.
+
+    Attributes:
+        converged: every phase reached its end.
+        failure: what failed and where ("" when converged).
+        phases: the continuation result of each phase, by name.
+        newton_iterations: total Newton iterations.
+        wall_time_s: wall-clock time [s].
+        knot_types: knot type after each converged load step.
+        pull_force_N: final pulling force (open knots) [N].
+        system: the last phase's system (its state is the result).
+    """
+
+    converged: bool
+    failure: str
+    phases: dict[str, StaticResult]
+    newton_iterations: int
+    wall_time_s: float
+    knot_types: list[str] = field(default_factory=list)
+    pull_force_N: float = 0.0
+    system: RodSystem | None = None
+
+
+def knot_type_of(scene: KnotScene, x: np.ndarray) -> str:
+    """Knot type of the centerline (open curves closed by a far-away arc)."""
+    pts = x if scene.closed else topology.close_open_curve(x)
+    return topology.knot_type(pts)
+
+
+def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | None):
+    def check(system: RodSystem, rec: StepRecord) -> str | None:
+        kt = knot_type_of(scene, system.state.x)
+        types.append(kt)
+        if hook is not None:
+            hook(phase, system, rec)
+        if kt != scene.knot_type:
+            return (f"topology changed in phase {phase} at load t={rec.t:.4g}: knot type "
+                    f"{kt}, expected {scene.knot_type} (the rod passed through itself)")
+        return None
+    return check
+
+
+def _opts(steps: int, tol: float) -> ContinuationOptions:
+    return ContinuationOptions(steps=steps, max_step=1.0 / steps, min_step=1e-4,
+                               newton=NewtonOptions(residual_tol=tol, max_iterations=60))
+
+
+def tie(
+    scene: KnotScene,
+    pull_force: float | None = None,
+    end_distance: float | None = None,
+    tighten_steps: int = 20,
+    pull_steps: int = 20,
+    residual_tol: float = 1e-6,
+    hold_force_scale: float = 0.05,
+    relax_iterations: int = 2000,
+    hook: StepHook | None = None,
+) -> TieResult:
+    """Tie ``scene``: shrink its rest length to L0, then (open knots) pull.
+
+    Args:
+        pull_force: final pulling force [N] (open knots).
+        end_distance: final end-to-end distance [m] (open knots; instead of a force).
+        tighten_steps, pull_steps: initial numbers of load steps (adaptive afterwards).
+        residual_tol: Newton tolerance on the scaled residual.
+        hold_force_scale: tension on a sliding end while tightening, over EI/D0^2.
+        relax_iterations: Newton budget of the relaxation of the start curve.
+        hook: called after each converged step with (phase, system, record).
+    """
+    if pull_force is not None and end_distance is not None:
+        raise ValueError("give pull_force or end_distance, not both")
+    if scene.closed and (pull_force is not None or end_distance is not None):
+        raise ValueError("a closed knot is not pulled: pull_force/end_distance are for open knots")
+    if pull_force is not None and not (math.isfinite(pull_force) and pull_force > 0):
+        raise ValueError(f"pull_force must be finite and > 0 N, got {pull_force!r}")
+    if end_distance is not None and not (math.isfinite(end_distance) and end_distance > 0):
+        raise ValueError(f"end_distance must be finite and > 0 m, got {end_distance!r}")
+    start = time.perf_counter()
+    types: list[str] = []
+    phases: dict[str, StaticResult] = {}
+    iters = 0
+    model = scene.model
+    f_unit = bending_force_scale(scene)
+    last = end_vertex(scene)
+    hold = hold_force_scale * f_unit
+    axis = scene.pull_axis if scene.pull_axis is not None else np.zeros(3)
+
+    def fail(msg: str, system: RodSystem | None, force: float) -> TieResult:
+        return TieResult(False, msg, phases, iters, time.perf_counter() - start, types,
+                         force, system)
+
+    # Phase 1: shrink the rest length from the start to L0.
+    shrink = 1.0 / scene.start_length_ratio
+    bcs = _copy_gauge(scene)
+    bcs.rest_length_scale((1.0, shrink))
+    if not scene.closed:
+        bcs.force(0, last, lambda t: hold * axis)
+    system = RodSystem(model, scene.state, bcs)
+    system.add_term(scene.contact)
+    system.set_load(0.0)
+    # The start curve is not an equilibrium: relax it first, with a budget for the long,
+    # floppy path of a loose knot (measured: 150 iterations for 150 vertices).
+    relax = newton_solve(system, system.free_vector(),
+                         NewtonOptions(residual_tol=residual_tol, max_iterations=relax_iterations))
+    iters += relax.iterations
+    if not relax.converged:
+        return fail(f"relax: Newton {relax.reason} (residual {relax.residual:.3g}) at the start",
+                    system, hold)
+    kt = knot_type_of(scene, system.state.x)
+    types.append(kt)
+    if kt != scene.knot_type:
+        return fail(f"relax: knot type {kt}, expected {scene.knot_type}", system, hold)
+    res = solve_static(system, _opts(tighten_steps, residual_tol),
+                       callback=_checker(scene, "tighten", types, hook))
+    phases["tighten"] = res
+    iters += res.newton_iterations
+    if not res.converged:
+        return fail(f"tighten: {res.failure}", system, hold)
+    if scene.closed or (pull_force is None and end_distance is None):
+        return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
+                         hold if not scene.closed else 0.0, system)
+
+    # Phase 2: pull.
+    state = system.state
+    bcs = _copy_gauge(scene, positions=state.x)
+    bcs.rest_length_scale((shrink, shrink))
+    if pull_force is not None:
+        f0 = hold
+
+        def force_path(t: float) -> np.ndarray:
+            return f0 * (pull_force / f0) ** t * axis
+
+        bcs.force(0, last, force_path)
+        final_force = pull_force
+    else:
+        d_now = float(np.linalg.norm(state.x[last] - state.x[0]))
+        delta = end_distance - d_now
+        bcs = _copy_gauge(scene, positions=state.x, sliding_end=False)
+        bcs.rest_length_scale((shrink, shrink))
+        bcs.pin(0, last, translation=delta * axis)
+        final_force = math.nan
+    system = RodSystem(model, state, bcs)
+    system.add_term(scene.contact)
+    system.set_load(0.0)
+    res = solve_static(system, _opts(pull_steps, residual_tol),
+                       callback=_checker(scene, "pull", types, hook))
+    phases["pull"] = res
+    iters += res.newton_iterations
+    if end_distance is not None:
+        # Reaction at the moved end: the residual force there is the pulling force.
+        final_force = end_reaction(system)
+    if not res.converged:
+        return fail(f"pull: {res.failure}", system, final_force)
+    return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
+                     final_force, system)
+
+
+def end_reaction(system: RodSystem) -> float:
+    """Axial force [N] needed to hold the last vertex where it is (the pulling force)."""
+    model = system.model
+    x = system.state.x
+    _, grad, _ = system.forces.evaluate(x, system.state.theta, system.state.m_ref, system.rest,
+                                        True, None)
+    g = grad[model.position_dofs][-1].copy()
+    for term in system.extra_terms:
+        _, gk, _ = term.evaluate(x, system.rest, True, False)
+        g += gk[-1]
+    return float(g[0])
+
+
+def _copy_gauge(scene: KnotScene, positions: np.ndarray | None = None,
+                sliding_end: bool = True) -> BoundaryConditions:
+    """The scene's gauge (pinned first end, sliding last end, rotation gauge) anew, at the
+    current positions (a BoundaryConditions keeps the positions it was built with)."""
+    model = scene.model
+    if positions is not None:
+        model.vertex_initial_position = positions.copy()
+    bcs = BoundaryConditions(model).pin(0, 0)
+    if scene.closed:
+        n = model.vertex_count
+        bcs.fix_components(0, n // 3, (1, 2)).fix_components(0, 2 * n // 3, (2,))
+        if model.twist:
+            bcs.fix_twist(0, 0)
+        return bcs
+    if sliding_end:
+        bcs.fix_components(0, -1, (1, 2))
+    bcs.fix_components(0, scene.info["gauge_vertex"], (2,))
+    return bcs
