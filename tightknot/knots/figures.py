@@ -30,6 +30,11 @@ def save_png_atomic(fig: Any, path: str | os.PathLike[str]) -> None:
     """Save ``fig`` as PNG to a temporary name beside ``path``, then rename (atomic)."""
     target = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    # mkstemp creates 0600 files; give the figure the usual permissions of the umask (as
+    # tightknot.atomic does), or it ends up readable by its owner only.
+    umask = os.umask(0)
+    os.umask(umask)
+    os.fchmod(fd, 0o666 & ~umask)
     os.close(fd)
     try:
         fig.savefig(tmp, format="png", dpi=DPI, bbox_inches="tight")
