@@ -8,7 +8,7 @@ import pytest
 
 from tightknot.cli import build_parser, main
 
-SUBCOMMANDS = ["verify", "bench", "demo", "fem", "calibrate"]
+SUBCOMMANDS = ["verify", "bench", "demo", "analyze", "fem", "calibrate"]
 
 
 @pytest.mark.parametrize("sub", SUBCOMMANDS)

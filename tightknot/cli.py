@@ -165,12 +165,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_demo)
 
-    try:
-        from tightknot.fem.commands import register as register_fem
-    except ImportError:  # pragma: no cover - the fem package itself always imports
-        register_fem = None
-    if register_fem is not None:
-        register_fem(sub)
+    from tightknot.fem.commands import register as register_fem
+    from tightknot.knots.commands import register as register_knots
+
+    register_knots(sub)
+    register_fem(sub)
     return parser
 
 

@@ -156,6 +156,9 @@ class ContactLayer:
         self._alloc(self._capacity)
         self.last_pairs = np.zeros((0, 2), dtype=np.int32)
         self.last_overlap = np.zeros(0)
+        #: Edge rest lengths of the last evaluation (the load path changes them): the
+        #: exclusion window of the step bound and of the checks is measured with these.
+        self.rest = model.edge_rest_length.copy()
 
     # -- load path -------------------------------------------------------------------------
     def set_radius_scale(self, scale: float) -> None:
@@ -226,6 +229,7 @@ class ContactLayer:
         triplets over global dofs."""
         m = self.model
         dev = self.device
+        self.rest = np.array(rest, dtype=np.float64)
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
         arcs, rod_len = self._arcs(rest)
         pairs = self._candidates(wx, self._zero_dx, self._margin, arcs, rod_len)
@@ -271,7 +275,7 @@ class ContactLayer:
         dev = self.device
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
         wdx = wp.array(np.ascontiguousarray(dx), dtype=wp.vec3d, device=dev)
-        arcs, rod_len = self._arcs(m.edge_rest_length)
+        arcs, rod_len = self._arcs(self.rest)
         # Sweep each edge's bounds over the step, inflated by half the hard limit.
         pairs = self._candidates(wx, wdx, self._half_hard(), arcs, rod_len)
         n = pairs.shape[0]
@@ -294,7 +298,7 @@ class ContactLayer:
         m = self.model
         dev = self.device
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
-        arcs, rod_len = self._arcs(m.edge_rest_length)
+        arcs, rod_len = self._arcs(self.rest)
         pairs = self._candidates(wx, self._zero_dx, self._half_hard(), arcs, rod_len)
         n = pairs.shape[0]
         if n == 0:
@@ -325,7 +329,7 @@ class ContactLayer:
         m = self.model
         dev = self.device
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
-        arcs, rod_len = self._arcs(m.edge_rest_length)
+        arcs, rod_len = self._arcs(self.rest)
         pairs = self._candidates(wx, self._zero_dx, self._margin, arcs, rod_len)
         n = pairs.shape[0]
         if n == 0:
@@ -339,3 +343,133 @@ class ContactLayer:
         k = int(np.argmin(d))
         pr = pairs.numpy()
         return float(d[k]), int(pr[k][0]), int(pr[k][1])
+
+
+def _segment_closest(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
+                     q1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closest-point parameters (s, t) of segment pairs (rows), Ericson 2005 sec. 5.1.9."""
+    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
+    a = np.einsum("ij,ij->i", d1, d1)
+    e = np.einsum("ij,ij->i", d2, d2)
+    f = np.einsum("ij,ij->i", d2, r)
+    c = np.einsum("ij,ij->i", d1, r)
+    b = np.einsum("ij,ij->i", d1, d2)
+    denom = a * e - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(denom > 1e-14 * a * e, np.clip((b * f - c * e) / denom, 0, 1), 0.0)
+        t = (b * s + f) / e
+        s = np.where(t < 0, np.clip(-c / a, 0, 1), np.where(t > 1, np.clip((b - c) / a, 0, 1), s))
+        t = np.clip(t, 0, 1)
+    return s, t
+
+
+def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
+    """Per-vertex contact outputs of the state ``x`` [m], derived from the law's fits.
+
+    For every non-local edge pair in contact, the closest points of the two segments give
+    the distance d, the law's overlap x = (R^2 - d^2)/(2R) (R = r_a + r_b, stretched radii)
+    and the contact normal; each side takes the per-side approach w = x/2 (identical rods,
+    contact_law docstring). Per edge, the largest w (w1) and the largest from the opposite
+    side (w2, normal more than 120 degrees away) are kept; a vertex takes the larger of its
+    edges'. Then, from the calibrated fits (tightknot/data/contact_law.json):
+    half-width b(w1); L_c = L_c,side(w1) + L_c,side(w2) (<= 1); mean pressure f_line(w1)/(2b);
+    peak pressure blended from the line and point fits by the crossing angle; area
+    A/A0 = (1/stretch)(1 - k_area (w_sq/D)^p) with w_sq = (w1 + w2)/2 (the calibration
+    squeezes both sides; a one-sided contact counts half), stretch from the vertex's edges.
+    A rigid-tube law reports no width, no pressure and the area of stretch alone.
+    """
+    m = layer.model
+    law = layer.law
+    n = m.vertex_count
+    rest = layer.rest
+    ev = m.edge_vertex
+    e = x[ev[:, 1]] - x[ev[:, 0]]
+    le = np.linalg.norm(e, axis=1)
+    stretch_e = le / rest
+    nu = np.array([m.rods[r].material.poisson_ratio for r in m.edge_rod])
+    radius_e = m.edge_radius * layer.radius_scale * stretch_e ** (-nu)
+    d0 = 2.0 * m.edge_radius
+    wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=layer.device)
+    arcs, rod_len = layer._arcs(rest)
+    pairs = layer._candidates(wx, layer._zero_dx, layer._margin, arcs, rod_len).numpy()
+    w1 = np.zeros(m.edge_count)
+    n1 = np.zeros((m.edge_count, 3))
+    w2 = np.zeros(m.edge_count)
+    xi_e = np.zeros(m.edge_count)
+    pair_list = np.zeros((0, 3))
+    if pairs.shape[0]:
+        a, b = pairs[:, 0], pairs[:, 1]
+        s, t = _segment_closest(x[ev[a, 0]], x[ev[a, 1]], x[ev[b, 0]], x[ev[b, 1]])
+        pa = x[ev[a, 0]] + s[:, None] * e[a]
+        pb = x[ev[b, 0]] + t[:, None] * e[b]
+        dvec = pb - pa
+        dist = np.linalg.norm(dvec, axis=1)
+        big_r = radius_e[a] + radius_e[b]
+        xo = (big_r**2 - dist**2) / (2.0 * big_r)
+        keep = xo > 0.0
+        a, b, s, t, dvec, dist, xo = a[keep], b[keep], s[keep], t[keep], dvec[keep], dist[
+            keep], xo[keep]
+        normal = dvec / np.maximum(dist, 1e-300)[:, None]
+        w = xo / 2.0
+        cosang = np.abs(np.einsum("ij,ij->i", e[a], e[b]) / (le[a] * le[b]))
+        q_line = math.cos(math.radians(law.angle_line_deg)) ** 2
+        q_point = math.cos(math.radians(law.angle_point_deg)) ** 2
+        u = np.clip((q_line - cosang**2) / (q_line - q_point), 0.0, 1.0)
+        xi = u**3 * (10 - 15 * u + 6 * u * u)
+        # Strongest contact per edge (both sides of each pair), then the opposite side.
+        for edges, nrm in ((a, normal), (b, -normal)):
+            order = np.argsort(w)
+            for k in order:  # ascending, so the largest ends up stored
+                j = edges[k]
+                if w[k] >= w1[j]:
+                    w1[j], n1[j], xi_e[j] = w[k], nrm[k], xi[k]
+        for edges, nrm in ((a, normal), (b, -normal)):
+            opp = np.einsum("ij,ij->i", nrm, n1[edges]) < -0.5
+            for k in np.flatnonzero(opp):
+                w2[edges[k]] = max(w2[edges[k]], w[k])
+        va = np.where(s < 0.5, ev[a, 0], ev[a, 1])
+        vb = np.where(t < 0.5, ev[b, 0], ev[b, 1])
+        pair_list = np.c_[va, vb, 2.0 * w]
+    # Edge -> vertex: the larger of the vertex's edges.
+    def to_vertex(val: np.ndarray) -> np.ndarray:
+        out = np.zeros(n)
+        np.maximum.at(out, ev[:, 0], val)
+        np.maximum.at(out, ev[:, 1], val)
+        return out
+
+    stretch_v = np.zeros(n)
+    cnt = np.zeros(n)
+    np.add.at(stretch_v, ev[:, 0], stretch_e)
+    np.add.at(stretch_v, ev[:, 1], stretch_e)
+    np.add.at(cnt, ev[:, 0], 1.0)
+    np.add.at(cnt, ev[:, 1], 1.0)
+    stretch_v /= np.maximum(cnt, 1.0)
+    dv = np.zeros(n)
+    np.maximum.at(dv, ev[:, 0], d0)
+    np.maximum.at(dv, ev[:, 1], d0)
+    w1v, w2v, xiv = to_vertex(w1), to_vertex(w2), to_vertex(xi_e)
+    emod = np.array([m.rods[r].material.youngs_modulus for r in m.vertex_rod])
+    f_line = law.k_line * emod * dv * (w1v / dv) ** law.p_line / emod  # f/E [m]
+    if law.rigid:
+        half = np.zeros(n)
+        lc = np.zeros(n)
+        p_mean = np.zeros(n)
+        p_peak = np.zeros(n)
+        area = 1.0 / stretch_v
+    else:
+        half = law.half_width(w1v, dv) if np.ndim(dv) == 0 else np.array(
+            [float(law.half_width(w, d)) for w, d in zip(w1v, dv, strict=True)])
+        lc = np.minimum(np.array([float(law.contact_fraction(a_, d) + law.contact_fraction(b_, d))
+                                  for a_, b_, d in zip(w1v, w2v, dv, strict=True)]), 1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            p_mean = np.where(half > 0, f_line / (2.0 * np.maximum(half, 1e-300)), 0.0)
+        p_peak = np.array([float((1 - xi_) * law.peak_pressure_line(w, d)
+                                 + xi_ * law.peak_pressure_point(w, d))
+                           for w, d, xi_ in zip(w1v, dv, xiv, strict=True)])
+        area = np.array([float(law.area_factor(0.5 * (a_ + b_), d))
+                         for a_, b_, d in zip(w1v, w2v, dv, strict=True)]) / stretch_v
+    return ContactReport(
+        overlap=2.0 * w1v, overlap_opposite=2.0 * w2v,
+        force_per_length=f_line * emod, half_width=half, contact_width_fraction=lc,
+        mean_pressure_over_E=p_mean, peak_pressure_over_E=p_peak, area_ratio=area,
+        pairs=pair_list)

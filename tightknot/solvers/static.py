@@ -25,6 +25,10 @@ class ContinuationOptions:
         max_step: largest step in t.
         grow_below: a step that converged in fewer Newton iterations than this doubles the next.
         newton: options of each Newton solve.
+        proximal_dt: when set, a load step whose static solve fails is first retried by
+            proximal steps (:func:`tightknot.solvers.dynamic.proximal_relax`) starting with
+            this time step [s], before the step is halved: the way through a limit point.
+        proximal_steps: their budget.
     """
 
     steps: int = 1
@@ -32,6 +36,8 @@ class ContinuationOptions:
     max_step: float = 1.0
     grow_below: int = 6
     newton: NewtonOptions = field(default_factory=NewtonOptions)
+    proximal_dt: float | None = None
+    proximal_steps: int = 100
 
     def __post_init__(self) -> None:
         if self.steps < 1:
@@ -70,6 +76,9 @@ class StaticResult:
 
 
 StepCallback = Callable[[RodSystem, StepRecord], str | None]
+#: predictor(system, t, t_next): moves the state toward the equilibrium at t_next before
+#: the Newton solve (called after the load is set to t_next).
+Predictor = Callable[[RodSystem, float, float], None]
 
 
 def solve_static(
@@ -77,11 +86,13 @@ def solve_static(
     options: ContinuationOptions | None = None,
     callback: StepCallback | None = None,
     t_start: float = 0.0,
+    predictor: Predictor | None = None,
 ) -> StaticResult:
     """Follow the load path from ``t_start`` to 1.
 
     ``callback(system, record)`` runs after each converged step; returning a string stops
     the run as failed with that reason (e.g. a topology check that found the knot changed).
+    ``predictor(system, t, t_next)`` may move the state before each step's Newton solve.
     """
     opt = options or ContinuationOptions()
     start = time.perf_counter()
@@ -103,8 +114,22 @@ def solve_static(
         t_next = min(1.0, t + dt)
         saved = system.state.copy()
         system.set_load(t_next)
+        if predictor is not None:
+            predictor(system, t, t_next)
         res = newton_solve(system, system.free_vector(), opt.newton)
         total_iters += res.iterations
+        if not res.converged and opt.proximal_dt is not None:
+            # The static path may have a limit point here: descend through it by proximal
+            # (fully damped implicit) steps from the last iterate at this load.
+            from tightknot.solvers.dynamic import proximal_relax
+
+            prox = proximal_relax(system, opt.proximal_dt, opt.proximal_steps, opt.newton)
+            total_iters += prox.newton_iterations
+            if prox.converged:
+                _, g, _ = system.evaluate(system.free_vector(), True, False)
+                res = NewtonResult(True, res.iterations + prox.newton_iterations,
+                                   system.residual_norm(g), 0.0, system.last_split.total,
+                                   "converged_by_proximal_steps", res.history)
         if not res.converged:
             system.state = saved
             system.set_load(t)
