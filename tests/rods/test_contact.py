@@ -176,3 +176,48 @@ def test_law_parameters_are_validated() -> None:
         RadialComplianceLaw(k_line=1.0, p_line=1.2, k_point=-1.0, p_point=1.5)
     with pytest.raises(ValueError, match="gauss_points"):
         ContactLayer(two_rods(0.0, 2 * D, n=5), LAW, gauss_points=5)
+
+
+def test_report_follows_the_fits_on_one_and_two_sided_squeeze() -> None:
+    from tightknot.rods.contact import contact_report
+
+    # One-sided: two parallel rods at pair overlap 0.1 D; each side has w = 0.05 D.
+    m = two_rods(0.0, distance_for_overlap(0.1))
+    rep = contact_report(ContactLayer(m, LAW), m.vertex_initial_position)
+    i = m.rods[1].vertex_start + 40
+    w = 0.05 * D
+    # The closest points are exact on straight strands: overlap to round-off.
+    assert rep.overlap[i] == pytest.approx(2 * w, rel=1e-9)
+    assert rep.overlap_opposite[i] == 0.0
+    assert rep.contact_width_fraction[i] == pytest.approx(LAW.c_lc * (w / D) ** LAW.p_lc)
+    assert rep.half_width[i] == pytest.approx(LAW.k_width * D * (w / D) ** LAW.p_width)
+    # A one-sided contact squeezes the area as half a two-sided one (report docstring).
+    assert rep.area_ratio[i] == pytest.approx(1 - LAW.k_area * (w / 2 / D) ** LAW.p_area)
+    assert rep.pairs.shape[1] == 3 and rep.pairs.shape[0] > 0
+
+    # Two-sided: a rod between two others, both at overlap 0.1 D: both sides count.
+    s = np.linspace(-10 * D, 10 * D, 81)
+    d = distance_for_overlap(0.1)
+    b = RodBuilder(twist=False)
+    for z in (-d, 0.0, d):
+        b.add_rod(np.c_[s, 0 * s, 0 * s + z], D, Material(E, 0.5, 1160.0))
+    m3 = b.finalize()
+    rep3 = contact_report(ContactLayer(m3, LAW), m3.vertex_initial_position)
+    j = m3.rods[1].vertex_start + 40
+    assert rep3.overlap_opposite[j] == pytest.approx(2 * w, rel=1e-9)
+    assert rep3.contact_width_fraction[j] == pytest.approx(
+        2 * LAW.c_lc * (w / D) ** LAW.p_lc)
+    assert rep3.area_ratio[j] == pytest.approx(1 - LAW.k_area * (w / D) ** LAW.p_area)
+
+
+def test_report_of_a_rigid_tube_and_of_free_rods() -> None:
+    from tightknot.rods.contact import contact_report
+
+    m = two_rods(0.0, distance_for_overlap(0.1))
+    rep = contact_report(ContactLayer(m, LAW.rigid_tube()), m.vertex_initial_position)
+    i = m.rods[1].vertex_start + 40
+    assert rep.overlap[i] > 0 and rep.contact_width_fraction[i] == 0.0
+    assert rep.area_ratio[i] == pytest.approx(1.0)
+    far = two_rods(0.0, 2.0 * D)
+    rep2 = contact_report(ContactLayer(far, LAW), far.vertex_initial_position)
+    assert not rep2.overlap.any() and np.allclose(rep2.area_ratio, 1.0)

@@ -36,6 +36,10 @@ _GAUSS = {
 }
 
 
+#: Bounds margin over the edge radius (see ContactLayer.__init__).
+_MARGIN = 1.1
+
+
 class SelfIntersectionError(ValueError):
     """The rods already pass through each other (closer than the hard limit)."""
 
@@ -145,9 +149,10 @@ class ContactLayer:
         ], dtype=f64, device=dev)
         self._exclusion = wp.array(exclusion_factor * diam, dtype=f64, device=dev)
         self._hard = wp.array(hard_fraction * diam, dtype=f64, device=dev)
-        # Interaction range of an edge: its radius, grown if compressed (r0 lam^-nu with
-        # lam >= 0.5 is at most 2^nu r0 <= 1.42 r0), so half the pair range is covered.
-        self._margin = wp.array(1.5 * m.edge_radius, dtype=f64, device=dev)
+        # Interaction range of an edge: its radius, grown if the edge is compressed
+        # (r0 lam^-nu: 1.1 r0 covers lam >= 0.83 at nu = 1/2), so that two edges whose
+        # Gauss points can interact (distance < r_a + r_b) have overlapping bounds.
+        self._margin = wp.array(_MARGIN * m.edge_radius, dtype=f64, device=dev)
         self._zero_dx = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
         self.radius_scale = 1.0
         #: Optional schedule t -> contact radius scale along a load path (inflation).
@@ -174,7 +179,7 @@ class ContactLayer:
         r = self.model.edge_radius * scale
         self._radius0 = wp.array(r, dtype=wp.float64, device=dev)
         self._hard = wp.array(self.hard_fraction * 2.0 * r, dtype=wp.float64, device=dev)
-        self._margin = wp.array(1.5 * r, dtype=wp.float64, device=dev)
+        self._margin = wp.array(_MARGIN * r, dtype=wp.float64, device=dev)
 
     def set_load(self, t: float) -> None:
         """Follow the radius schedule (if any) at load parameter t."""
@@ -251,27 +256,32 @@ class ContactLayer:
                           self._law, wx, pairs, wrest, arcs, rod_len, self._exclusion,
                           int(want_grad or want_hess), int(want_hess)],
                   outputs=[energy, grad, hess, overlap])
-        e = float(energy.numpy().sum())
+        e_pair = energy.numpy()
+        e = float(e_pair.sum())
         pr = pairs.numpy().astype(np.int64)
         self.last_pairs = pr
         self.last_overlap = overlap.numpy().copy()
         g = grad.numpy().copy() if want_grad else None
         coo = None
         if want_hess:
+            # Only pairs that interact carry a Hessian (most candidates do not).
+            active = np.flatnonzero(e_pair != 0.0)
+            pr = pr[active]
+            npairs = active.size
+            hvals = hess.numpy().reshape(-1, 144)[active].ravel()
             ev = m.edge_vertex.astype(np.int64)
             verts = np.concatenate([ev[pr[:, 0]], ev[pr[:, 1]]], axis=1)  # (P, 4)
             dofs = (m.vertex_dof.astype(np.int64)[verts][:, :, None] + np.arange(3)).reshape(
                 -1, 12)
             rows = np.broadcast_to(dofs[:, :, None], (npairs, 12, 12)).ravel()
             cols = np.broadcast_to(dofs[:, None, :], (npairs, 12, 12)).ravel()
-            coo = (rows, cols, hess.numpy().copy())
+            coo = (rows, cols, hvals)
         return e, g, coo
 
     # -- no passing through ----------------------------------------------------------------
     def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
         """Largest fraction of the step ``dx`` [m] (vertices) that keeps every non-local
         segment pair at least the hard limit apart along the straight path (1 = full)."""
-        m = self.model
         dev = self.device
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
         wdx = wp.array(np.ascontiguousarray(dx), dtype=wp.vec3d, device=dev)
@@ -295,7 +305,6 @@ class ContactLayer:
     def check_no_intersection(self, x: np.ndarray) -> None:
         """Refuse positions whose non-local segments are closer than the hard limit,
         saying where (rest arc lengths of the offending pair)."""
-        m = self.model
         dev = self.device
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
         arcs, rod_len = self._arcs(self.rest)
@@ -326,7 +335,6 @@ class ContactLayer:
     def min_distance(self, x: np.ndarray) -> tuple[float, int, int]:
         """Smallest non-local segment distance [m] among pairs within the interaction
         range, and its edge pair (inf, -1, -1 when none)."""
-        m = self.model
         dev = self.device
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
         arcs, rod_len = self._arcs(self.rest)
@@ -457,17 +465,12 @@ def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
         p_peak = np.zeros(n)
         area = 1.0 / stretch_v
     else:
-        half = law.half_width(w1v, dv) if np.ndim(dv) == 0 else np.array(
-            [float(law.half_width(w, d)) for w, d in zip(w1v, dv, strict=True)])
-        lc = np.minimum(np.array([float(law.contact_fraction(a_, d) + law.contact_fraction(b_, d))
-                                  for a_, b_, d in zip(w1v, w2v, dv, strict=True)]), 1.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            p_mean = np.where(half > 0, f_line / (2.0 * np.maximum(half, 1e-300)), 0.0)
-        p_peak = np.array([float((1 - xi_) * law.peak_pressure_line(w, d)
-                                 + xi_ * law.peak_pressure_point(w, d))
-                           for w, d, xi_ in zip(w1v, dv, xiv, strict=True)])
-        area = np.array([float(law.area_factor(0.5 * (a_ + b_), d))
-                         for a_, b_, d in zip(w1v, w2v, dv, strict=True)]) / stretch_v
+        half = law.half_width(w1v, dv)
+        lc = np.minimum(law.contact_fraction(w1v, dv) + law.contact_fraction(w2v, dv), 1.0)
+        p_mean = np.where(half > 0, f_line / (2.0 * np.maximum(half, 1e-300)), 0.0)
+        p_peak = (1 - xiv) * law.peak_pressure_line(w1v, dv) + xiv * law.peak_pressure_point(
+            w1v, dv)
+        area = law.area_factor(0.5 * (w1v + w2v), dv) / stretch_v
     return ContactReport(
         overlap=2.0 * w1v, overlap_opposite=2.0 * w2v,
         force_per_length=f_line * emod, half_width=half, contact_width_fraction=lc,
