@@ -19,3 +19,12 @@ def indent_coarse():
     from tightknot.fem import run_scene
 
     return run_scene("indent", mesh="coarse", convergence=False)
+
+
+@pytest.fixture(scope="session")
+def wrap_coarse():
+    """Wrap on the coarse mesh (960 hexahedra, 6 tension levels, 30 to 40 s on 2 cores)."""
+    pytest.importorskip("felupe")
+    from tightknot.fem import run_scene
+
+    return run_scene("wrap", mesh="coarse", convergence=False)

@@ -15,7 +15,18 @@ from tightknot.fem.commands import register
     ("kwargs", "name"),
     [
         (dict(name="knot"), "name"),
-        (dict(name="wrap"), "name"),
+        (dict(name="wrap", max_approach_over_d0=0.3), "max_approach_over_d0"),
+        (dict(name="wrap", max_tension_over_e_d0sq=0.0), "max_tension_over_e_d0sq"),
+        (dict(name="wrap", max_tension_over_e_d0sq=0.8), "max_tension_over_e_d0sq"),
+        (dict(name="wrap", max_tension_over_e_d0sq=float("inf")), "max_tension_over_e_d0sq"),
+        (dict(name="wrap", wrap_angle_deg=180.0), "wrap_angle_deg"),
+        (dict(name="wrap", wrap_angle_deg=5.0), "wrap_angle_deg"),
+        (dict(name="wrap", length_over_d0=2.0), "length_over_d0"),
+        (dict(name="wrap", mesh="huge"), "mesh"),
+        (dict(name="wrap", steps=0), "steps"),
+        (dict(name="wrap", diameter=-1.0), "diameter"),
+        (dict(name="wrap", youngs_modulus=0.0), "youngs_modulus"),
+        (dict(name="wrap", bogus=1), "bogus"),
         (dict(name="squeeze", max_approach_over_d0=1.0), "max_approach_over_d0"),
         (dict(name="squeeze", max_approach_over_d0=0.0), "max_approach_over_d0"),
         (dict(name="squeeze", max_approach_over_d0=-0.1), "max_approach_over_d0"),
@@ -37,7 +48,7 @@ def test_bad_input_names_the_parameter(kwargs, name):
 
 
 def test_scenes_listed():
-    assert SCENES == ("squeeze", "indent")
+    assert SCENES == ("squeeze", "indent", "wrap")
 
 
 def _parser():

@@ -6,10 +6,11 @@ penalty contact against rigid plates and cylinders. FElupe is GPL-3.0 and option
 
 Public API::
 
-    run_scene(name, mesh="coarse", max_approach_over_d0=0.3, steps=None, **options) -> dict
-    SCENES  # names of the scenes: "squeeze", "indent"
+    run_scene(name, mesh="coarse", max_approach_over_d0=None, steps=None, **options) -> dict
+    SCENES  # names of the scenes: "squeeze", "indent", "wrap"
     calibration.calibrate(mesh="medium"), calibration.write_law(path)
-    commands.register(subparsers)  # CLI subcommands "fem" and "calibrate"
+    crosscheck.crosscheck(mesh="coarse")  # FEM versus rod model on indent and wrap
+    commands.register(subparsers)  # CLI subcommands "fem", "calibrate", "fem crosscheck"
 """
 
 from __future__ import annotations
@@ -20,44 +21,53 @@ from typing import Any
 
 from ._backend import INSTALL_HINT, FelupeMissingError, require_felupe
 
-SCENES: tuple[str, ...] = ("squeeze", "indent")
-"""Names of the implemented FEM scenes (``wrap`` is planned, not implemented)."""
+SCENES: tuple[str, ...] = ("squeeze", "indent", "wrap")
+"""Names of the implemented FEM scenes."""
 
-PLANNED_SCENES: tuple[str, ...] = ("wrap",)
-"""Scenes of the design that are not implemented yet (run_scene refuses them)."""
-
-DEFAULT_STEPS: dict[str, int] = {"squeeze": 12, "indent": 10}
+DEFAULT_STEPS: dict[str, int] = {"squeeze": 12, "indent": 10, "wrap": 6}
 """Default number of load steps per scene."""
 
 __all__ = ["SCENES", "INSTALL_HINT", "FelupeMissingError", "run_scene", "require_felupe"]
 
 
-def run_scene(name: str, mesh: str = "coarse", max_approach_over_d0: float = 0.3,
+DEFAULT_APPROACH: float = 0.3
+"""Default total approach over D0 of the displacement-controlled scenes."""
+
+
+def run_scene(name: str, mesh: str = "coarse", max_approach_over_d0: float | None = None,
               steps: int | None = None, **options: Any) -> dict[str, Any]:
     """Run the FEM scene ``name`` and return its JSON-serialisable result.
 
     ``mesh`` is "coarse", "medium" or "fine"; ``max_approach_over_d0`` the total approach
-    of the two rigid bodies over D0 (in (0, 1); 2 w per side); ``steps`` the number of
-    load steps (default per scene). ``options`` go to the scene (squeeze: ``model``
-    "plane_strain" | "3d", ``ends`` "plane" | "free", ``length_over_d0``; both:
-    ``convergence`` (bool, default True: also run the three meshes for the
-    ``mesh_convergence`` table), ``diameter``, ``youngs_modulus``).
+    of the two rigid bodies over D0 (in (0, 1); 2 w per side; default 0.3; squeeze and
+    indent only: ``wrap`` is force-controlled and takes ``max_tension_over_e_d0sq``
+    instead); ``steps`` the number of load steps (default per scene). ``options`` go to
+    the scene (squeeze: ``model`` "plane_strain" | "3d", ``ends`` "plane" | "free",
+    ``length_over_d0``; wrap: ``max_tension_over_e_d0sq``, ``wrap_angle_deg``,
+    ``length_over_d0``; all: ``convergence`` (bool, default True: also run the three
+    meshes for the ``mesh_convergence`` table), ``diameter``, ``youngs_modulus``).
 
     Result keys: ``scene``, ``mesh``, ``parameters``, ``steps`` (list of per-step dicts),
     ``hertz``, ``mesh_convergence``, ``wall_time_s``. Raises ValueError for bad input
     (unknown scene, approach outside (0, 1), non-positive sizes) and
     :class:`FelupeMissingError` (an ImportError) when FElupe is not installed.
     """
-    if name in PLANNED_SCENES:
-        raise ValueError(f"name: scene {name!r} is planned but not implemented; "
-                         f"valid scenes: {SCENES}")
     if name not in SCENES:
         raise ValueError(f"name must be one of {SCENES}, got {name!r}")
     if steps is None:
         steps = DEFAULT_STEPS[name]
-    from .scenes import indent, squeeze
+    from .scenes import indent, squeeze, wrap
 
-    module = {"squeeze": squeeze, "indent": indent}[name]
+    module = {"squeeze": squeeze, "indent": indent, "wrap": wrap}[name]
+    loads: dict[str, Any] = {}
+    if name == "wrap":
+        if max_approach_over_d0 is not None:
+            raise ValueError("max_approach_over_d0 is not a parameter of the force-controlled "
+                             "scene 'wrap': give max_tension_over_e_d0sq (tension over "
+                             "E D0^2) instead")
+    else:
+        loads["max_approach_over_d0"] = (DEFAULT_APPROACH if max_approach_over_d0 is None
+                                         else max_approach_over_d0)
     allowed = set(inspect.signature(module.run).parameters) - {"mesh", "max_approach_over_d0",
                                                                 "steps"}
     unknown = sorted(set(options) - allowed)
@@ -65,7 +75,6 @@ def run_scene(name: str, mesh: str = "coarse", max_approach_over_d0: float = 0.3
         raise ValueError(f"options {unknown} are not valid for scene {name!r}; "
                          f"valid options: {sorted(allowed)}")
     start = time.perf_counter()
-    result = module.run(mesh=mesh, max_approach_over_d0=max_approach_over_d0, steps=steps,
-                        **options)
+    result = module.run(mesh=mesh, steps=steps, **loads, **options)
     result["wall_time_s"] = time.perf_counter() - start  # all meshes included
     return result

@@ -20,6 +20,8 @@ _FEM_EXAMPLES = """examples:
   tightknot fem squeeze --mesh medium --json out/squeeze.json
   tightknot fem squeeze --model 3d --ends free  # 3D segment with free ends
   tightknot fem indent --mesh coarse --no-convergence
+  tightknot fem wrap --tension 0.25 --wrap-angle 90 --no-convergence
+  tightknot fem crosscheck --json out/crosscheck.json   # FEM versus rod model
 """
 
 _CAL_EXAMPLES = """examples:
@@ -35,10 +37,16 @@ def register(subparsers: Any) -> None:
         description="Run a FEM contact scene of a nearly incompressible neo-Hookean rod "
                     "(E = 1.25 MPa, D0 = 8.5 mm) and print or save its JSON result.",
         epilog=_FEM_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    fem.add_argument("scene", help="squeeze | indent | wrap (wrap: not implemented yet)")
+    fem.add_argument("scene", help="squeeze | indent | wrap, or crosscheck (indent and wrap "
+                                   "with the FEM and with the rod model, compared)")
     fem.add_argument("--mesh", default="coarse", help="coarse | medium | fine")
-    fem.add_argument("--approach", type=float, default=0.3,
-                     help="total approach over D0, in (0, 1) (default 0.3)")
+    fem.add_argument("--approach", type=float, default=None,
+                     help="squeeze, indent: total approach over D0, in (0, 1) (default 0.3)")
+    fem.add_argument("--tension", type=float, default=None,
+                     help="wrap only: largest end tension over E D0^2, in (0, 0.5] "
+                          "(default 0.25)")
+    fem.add_argument("--wrap-angle", type=float, default=None,
+                     help="wrap only: angle between the two tails [deg] (default 90)")
     fem.add_argument("--steps", type=int, default=None, help="number of load steps")
     fem.add_argument("--model", default=None, help="squeeze only: plane_strain | 3d")
     fem.add_argument("--ends", default=None, help="squeeze 3d only: plane | free")
@@ -77,7 +85,13 @@ def _run_fem(args: argparse.Namespace) -> int:
     problem = _check_out(args.json)
     if problem:
         return _fail(problem)
+    if args.scene == "crosscheck":
+        return _run_crosscheck(args)
     options: dict[str, Any] = {"convergence": not args.no_convergence}
+    if args.tension is not None:
+        options["max_tension_over_e_d0sq"] = args.tension
+    if args.wrap_angle is not None:
+        options["wrap_angle_deg"] = args.wrap_angle
     if args.model is not None:
         options["model"] = args.model
     if args.ends is not None:
@@ -94,6 +108,33 @@ def _run_fem(args: argparse.Namespace) -> int:
 
         write_json_atomic(args.json, result)
     return 0
+
+
+def _run_crosscheck(args: argparse.Namespace) -> int:
+    """``fem crosscheck``: exit 0 when every target is met, 1 when one is missed (the
+    report is written either way), 2 for bad input or a missing FElupe."""
+    from .scenes._common import finite
+
+    problem = _check_out(args.json)
+    if problem:
+        return _fail(problem)
+    try:
+        from .crosscheck import crosscheck
+
+        report = crosscheck(mesh=args.mesh)
+    except (ValueError, FelupeMissingError) as err:
+        return _fail(str(err))
+    if args.json is None:
+        print(json.dumps(finite(report), indent=2, allow_nan=False))
+    else:
+        from tightknot.atomic import write_json_atomic
+
+        write_json_atomic(args.json, report)
+    summary = {name: scene["comparison"]["worst"] for name, scene in report["scenes"].items()}
+    print(json.dumps({"passed": report["passed"],
+                      "fem_over_rod_time_ratio": report["fem_over_rod_time_ratio"],
+                      "worst": summary}), file=sys.stderr)
+    return 0 if report["passed"] else 1
 
 
 def _run_calibrate(args: argparse.Namespace) -> int:

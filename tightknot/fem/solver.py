@@ -31,7 +31,11 @@ class Problem:
 
     ``field`` is the FElupe ``FieldContainer`` (displacement first), ``solid`` the FElupe
     solid body, ``fixed`` a boolean mask over the dofs (point-major: point * dim + axis),
-    ``force_scale`` [N or N/m] a force used for the relative convergence test.
+    ``force_scale`` [N or N/m] a force used for the relative convergence test,
+    ``external`` [N] an optional dead (fixed-direction) load vector over the dofs, set by a
+    force-controlled scene's ``apply`` (the residual is internal + contact - external),
+    ``max_backtracks`` how many times a Newton correction that inverts elements is halved
+    before the increment fails (0: fail at once, the behaviour the calibrated scenes had).
     """
 
     field: Any
@@ -40,6 +44,8 @@ class Problem:
     fixed: np.ndarray
     force_scale: float
     iterations: list[int] = field(default_factory=list)
+    external: np.ndarray | None = None
+    max_backtracks: int = 0
 
     @property
     def mesh(self) -> Any:
@@ -59,6 +65,8 @@ class Problem:
         """Residual vector [N] and tangent matrix [N/m] of solid plus contacts."""
         solid = self.solid
         r = np.asarray(solid.assemble.vector(self.field).todense()).ravel()
+        if self.external is not None:
+            r = r - self.external  # dead load: no stiffness contribution
         k = solid.assemble.matrix().tocoo()
         rows, cols, data = [k.row], [k.col], [k.data]
         x = self.positions()
@@ -85,21 +93,38 @@ class Problem:
         """
         free = ~self.fixed
         size = np.ptp(self.mesh.points, axis=0).max()
+        checkpoint: dict | None = None
+        du = np.zeros(self.fixed.size)
+        backtracks = 0
         for it in range(1, maxiter + 1):
             r, k = self.assemble()
             r_free = r[free]
-            reaction = np.linalg.norm(r[self.fixed]) + sum(
+            if not np.all(np.isfinite(r_free)):
+                # An over-long correction inverted elements (J <= 0): go back to the last
+                # iterate (FElupe's condensed p, J-bar fields included) and take half of it.
+                # Force-controlled scenes meet this when a tail swings; displacement-
+                # controlled ones converge without it.
+                if checkpoint is None or backtracks >= self.max_backtracks:
+                    raise NewtonFailure(f"non-finite residual (iteration {it}, "
+                                        f"{backtracks} backtracks)")
+                self.solid.restore(checkpoint)
+                du *= 0.5
+                self.field[0].values[:] += du.reshape(-1, self.dim)
+                backtracks += 1
+                continue
+            applied = 0.0 if self.external is None else float(np.linalg.norm(self.external))
+            reaction = applied + np.linalg.norm(r[self.fixed]) + sum(
                 np.linalg.norm(c.evaluate(self.positions()[c.points])[0]) for c in self.contacts
             )
             scale = max(reaction, 1e-3 * self.force_scale)
-            if not np.all(np.isfinite(r_free)):
-                raise NewtonFailure("non-finite residual")
             k_free = k[free][:, free].tocsc()
             lu = splu(k_free, diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
             du = np.zeros_like(r)
             du[free] = -lu.solve(r_free)
             if not np.all(np.isfinite(du)):
                 raise NewtonFailure("non-finite correction")
+            if self.max_backtracks > 0:
+                checkpoint = self.solid.checkpoint()
             self.field[0].values[:] += du.reshape(-1, self.dim)
             if np.linalg.norm(r_free) <= tol * scale and np.abs(du).max() <= 1e-9 * size:
                 return it
