@@ -1,6 +1,6 @@
 """Benchmark of the FEM scenes: wall time, element count and headline outputs per mesh.
 
-Usage: ``python bench/fem_scenes.py [--scenes squeeze indent] [--meshes coarse medium]
+Usage: ``python bench/fem_scenes.py [--scenes squeeze indent wrap] [--meshes coarse medium]
 [--json out.json]``. Needs the optional extra (pip install "tightknot[fem]").
 """
 
@@ -16,6 +16,7 @@ CASES = {
     "squeeze": [dict(model="plane_strain"), dict(model="3d", ends="plane"),
                 dict(model="3d", ends="free")],
     "indent": [dict()],
+    "wrap": [dict()],  # force-controlled: tension up to 0.25 E D0^2, wrap angle 90 degrees
 }
 
 

@@ -97,7 +97,10 @@ class Problem:
         du = np.zeros(self.fixed.size)
         backtracks = 0
         for it in range(1, maxiter + 1):
-            r, k = self.assemble()
+            # with backtracking, an inverted trial element (J <= 0 in FElupe's J^(-2/3)) is
+            # an expected event handled below, not a warning for the user
+            with np.errstate(invalid="ignore" if self.max_backtracks else "warn"):
+                r, k = self.assemble()
             r_free = r[free]
             if not np.all(np.isfinite(r_free)):
                 # An over-long correction inverted elements (J <= 0): go back to the last
