@@ -58,14 +58,23 @@ def iteration_time(n: int, repeats: int = 5, device: str = "cpu") -> dict:
 
 _STARTUP = (
     "import time; t=time.perf_counter();"
+    "import numpy as np;"
     "from tightknot.verification.cases import neo_hookean_stretch;"
-    "neo_hookean_stretch(); print(time.perf_counter()-t)"
+    "from tightknot.rods.builder import RodBuilder;"
+    "from tightknot.rods.contact import ContactLayer;"
+    "neo_hookean_stretch();"
+    "s=np.linspace(0,0.1,11); b=RodBuilder(twist=False);"
+    "b.add_rod(np.c_[s,0*s,0*s],0.01); b.add_rod(np.c_[0*s+0.05,s-0.05,0*s+0.009],0.01);"
+    "m=b.finalize(); ContactLayer(m).evaluate(m.vertex_initial_position,"
+    "m.edge_rest_length,True,True);"
+    "print(time.perf_counter()-t)"
 )
 
 
 def startup_time(cache_dir: str | None) -> float:
-    """Seconds to import tightknot, load (or compile) its kernels and solve a tiny case,
-    in a fresh Python process; ``cache_dir`` is the Warp kernel cache to use."""
+    """Seconds to import tightknot, load (or compile) all its kernel modules (elastic and
+    contact) and solve a tiny case, in a fresh Python process; ``cache_dir`` is the Warp
+    kernel cache to use."""
     env = dict(os.environ)
     if cache_dir is not None:
         env["WARP_CACHE_PATH"] = cache_dir

@@ -23,7 +23,12 @@ import numpy as np
 import warp as wp
 
 from tightknot.rods import contact_kernels as ck
-from tightknot.rods.contact_law import RadialComplianceLaw
+from tightknot.rods.contact_law import (
+    TABLE_INTERVALS,
+    U_MIN,
+    RadialComplianceLaw,
+    kernel_table,
+)
 from tightknot.rods.model import Model
 from tightknot.warp_setup import init_warp
 
@@ -139,14 +144,17 @@ class ContactLayer:
         self._gxi = wp.array(xi, dtype=f64, device=dev)
         self._gw = wp.array(w, dtype=f64, device=dev)
         law_ = self.law
-        a_l = law_.p_line + 0.5
-        beta = math.sqrt(math.pi) * math.gamma(a_l + 1.0) / math.gamma(a_l + 1.5)
         self._law = wp.array([
-            law_.k_line, law_.p_line + 1.0, beta, law_.k_point, law_.p_point + 1.0,
+            law_.k_line, law_.p_line + 1.0, 0.0, law_.k_point, law_.p_point + 1.0,
             math.cos(math.radians(law_.angle_line_deg)) ** 2,
-            math.cos(math.radians(law_.angle_point_deg)) ** 2, law_.smoothing,
+            math.cos(math.radians(law_.angle_point_deg)) ** 2, 0.0,
             core_fraction, hard_fraction, core_stiffness,
+            U_MIN, (1.0 - U_MIN) / TABLE_INTERVALS,
         ], dtype=f64, device=dev)
+        self._line_table = wp.array(kernel_table("line", law_.p_line + 1.0), dtype=f64,
+                                    device=dev)
+        self._point_table = wp.array(kernel_table("point", law_.p_point + 1.0), dtype=f64,
+                                     device=dev)
         self._exclusion = wp.array(exclusion_factor * diam, dtype=f64, device=dev)
         self._hard = wp.array(hard_fraction * diam, dtype=f64, device=dev)
         # Interaction range of an edge: its radius, grown if the edge is compressed
@@ -253,7 +261,8 @@ class ContactLayer:
         wp.launch(ck.contact_pair_kernel, dim=npairs, device=dev,
                   inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, self._radius0,
                           self._law_radius, self._poisson, self._modulus, self._gxi, self._gw,
-                          self._law, wx, pairs, wrest, arcs, rod_len, self._exclusion,
+                          self._law, self._line_table, self._point_table, wx, pairs, wrest,
+                          arcs, rod_len, self._exclusion,
                           int(want_grad or want_hess), int(want_hess)],
                   outputs=[energy, grad, hess, overlap])
         e_pair = energy.numpy()
@@ -375,8 +384,8 @@ def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
     """Per-vertex contact outputs of the state ``x`` [m], derived from the law's fits.
 
     For every non-local edge pair in contact, the closest points of the two segments give
-    the distance d, the law's overlap x = (R^2 - d^2)/(2R) (R = r_a + r_b, stretched radii)
-    and the contact normal; each side takes the per-side approach w = x/2 (identical rods,
+    the distance d, the pair overlap delta = R - d (R = r_a + r_b, stretched radii) and the
+    contact normal; each side takes the per-side approach w = delta/2 (identical rods,
     contact_law docstring). Per edge, the largest w (w1) and the largest from the opposite
     side (w2, normal more than 120 degrees away) are kept; a vertex takes the larger of its
     edges'. Then, from the calibrated fits (tightknot/data/contact_law.json):
@@ -413,7 +422,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
         dvec = pb - pa
         dist = np.linalg.norm(dvec, axis=1)
         big_r = radius_e[a] + radius_e[b]
-        xo = (big_r**2 - dist**2) / (2.0 * big_r)
+        xo = big_r - dist  # pair overlap delta
         keep = xo > 0.0
         a, b, s, t, dvec, dist, xo = a[keep], b[keep], s[keep], t[keep], dvec[keep], dist[
             keep], xo[keep]

@@ -1,22 +1,25 @@
 """Warp kernels of the self-contact layer: broad phase, pair energy, step bound, outputs.
 
 One module, compiled once. Float64 geometry (tight contact needs it); the BVH bounds are
-float32 (Warp's BVH), inflated by a margin that covers their rounding.
+float32 (Warp's BVH), inflated by a margin that covers their rounding. Loops are not
+unrolled (``max_unroll`` 1): unrolling the 4 x 4 vertex blocks made this module take 38 s
+to compile.
 
 Pair energy (see :mod:`tightknot.rods.contact_law` for the derivation): for an edge pair
-(a, b) and Gauss points g on a, h on b,
+(a, b) and Gauss points g on a, h on b at distance rho,
 
-    U_gh = om_g om_h l_a l_b W_excl Psi(s, R, q),   s = |x_g - x_h|^2,
-    Psi = (1 - xi(q)) C_l h(x)^al_l + xi(q) sqrt(1 - q) C_p h(x)^al_p,
-    x = (R^2 - s)/(2R),  R = r_a + r_b,  r = r0 (l/l_bar)^-nu,  q = cos^2(angle of a, b),
+    U_gh = om_g om_h l_a l_b W_excl Psi(s, R, q),   s = rho^2,
+    Psi = (1 - xi(q)) A_l R^k_l T_l(rho/R) + xi(q) sqrt(1 - q) A_p R^k_p T_p(rho/R) + b(s),
 
-with om the Gauss weights on [0, 1], l the current edge lengths (the law is per unit length
-of the deformed rod), xi the C2 line-to-point blend by angle (Meier et al. 2016) and
-W_excl a C2 ramp of the arc-length separation (the exclusion window). U is a function of
-four scalars z = (s, l_a, l_b, q) of the vectors Y = (r = x_g - x_h, e_a, e_b); gradient
-and Hessian follow by the chain rule through z and Y, then the linear map Y -> vertices.
-Local vertex order of a pair: [a0, a1, b0, b1]; Hessian entry (3 v + i, 3 w + j) at
-``pair * 144 + (3 v + i) * 12 + 3 w + j``.
+with T_l, T_p the tabulated Abel and radial inverses of the line and point laws (cubic
+splines, C2), R = r_a + r_b, r = r0 (l/l_bar)^-nu, q = cos^2 of the edges' angle, om the
+Gauss weights on [0, 1], l the current edge lengths (the law is per unit length of the
+deformed rod), xi the C2 line-to-point blend by angle (Meier et al. 2016), W_excl a C2
+ramp of the arc-length separation (the exclusion window) and b the hard-core barrier.
+U is a function of four scalars z = (s, l_a, l_b, q) of the vectors Y = (r = x_g - x_h,
+e_a, e_b); gradient and Hessian follow by the chain rule through z and Y, then the linear
+map Y -> vertices. Local vertex order of a pair: [a0, a1, b0, b1]; Hessian entry
+(3 v + i, 3 w + j) at ``pair * 144 + (3 v + i) * 12 + 3 w + j``.
 """
 
 from __future__ import annotations
@@ -24,6 +27,8 @@ from __future__ import annotations
 import warp as wp
 
 f64 = wp.float64
+# Compile time: see the module docstring.
+wp.set_module_options({"max_unroll": 1})
 
 
 @wp.func
@@ -41,35 +46,38 @@ def smooth_ramp(u: wp.float64) -> wp.vec3d:
 
 
 @wp.func
-def positive_part(x: wp.float64, eps: wp.float64) -> wp.vec3d:
-    """C2 positive part h(x) with onset band [-eps, eps], and h', h''.
-
-    h = (x + eps)^3 (3 eps - x)/(16 eps^3) inside the band: h(-eps) = h'(-eps) = h''(-eps) = 0
-    and h(eps) = eps, h'(eps) = 1, h''(eps) = 0.
-    """
-    if x <= -eps:
+def table_eval(table: wp.array2d(dtype=wp.float64), u0: wp.float64, du: wp.float64,
+               u: wp.float64) -> wp.vec3d:
+    """Cubic-spline table T(u) with T' and T'' (zero for u >= 1; the first piece
+    extrapolated below u0)."""
+    if u >= f64(1.0):
         return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
-    if x >= eps:
-        return wp.vec3d(x, f64(1.0), f64(0.0))
-    y = x + eps
-    e3 = f64(16.0) * eps * eps * eps
-    h = y * y * y * (f64(3.0) * eps - x) / e3
-    h1 = (f64(3.0) * y * y * (f64(3.0) * eps - x) - y * y * y) / e3
-    h2 = (f64(6.0) * y * (f64(3.0) * eps - x) - f64(6.0) * y * y) / e3
-    return wp.vec3d(h, h1, h2)
+    n = table.shape[0]
+    j = int(wp.floor((u - u0) / du))
+    j = wp.clamp(j, 0, n - 1)
+    t = u - (u0 + f64(j) * du)
+    a = table[j, 0]
+    b = table[j, 1]
+    c = table[j, 2]
+    d = table[j, 3]
+    return wp.vec3d(a + t * (b + t * (c + t * d)), b + t * (f64(2.0) * c + f64(3.0) * t * d),
+                    f64(2.0) * c + f64(6.0) * t * d)
 
 
 @wp.func
-def power_of_ramp(hv: wp.vec3d, coef: wp.float64, alpha: wp.float64) -> wp.vec3d:
-    """G = coef h^alpha and its first two derivatives in x, given (h, h', h'')."""
-    h = hv[0]
-    if h <= f64(1.0e-300):
-        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
-    ha = wp.pow(h, alpha)
-    g = coef * ha
-    g1 = coef * alpha * ha / h * hv[1]
-    g2 = coef * alpha * (ha / h) * ((alpha - f64(1.0)) / h * hv[1] * hv[1] + hv[2])
-    return wp.vec3d(g, g1, g2)
+def scaled_kernel(T: wp.vec3d, amp: wp.float64, k: wp.float64, R: wp.float64,
+                  u: wp.float64) -> wp.mat33d:
+    """f = amp R^k T(rho/R) and its derivatives, packed as
+    [[f, f_rho, f_R], [f_rhorho, f_rhoR, f_RR], [0, 0, 0]]."""
+    rk = amp * wp.pow(R, k)
+    f = rk * T[0]
+    f_r = rk / R * T[1]
+    f_R = rk / R * (k * T[0] - u * T[1])
+    f_rr = rk / (R * R) * T[2]
+    f_rR = rk / (R * R) * ((k - f64(1.0)) * T[1] - u * T[2])
+    f_RR = rk / (R * R) * (k * (k - f64(1.0)) * T[0] - f64(2.0) * (k - f64(1.0)) * u * T[1]
+                           + u * u * T[2])
+    return wp.mat33d(f, f_r, f_R, f_rr, f_rR, f_RR, f64(0.0), f64(0.0), f64(0.0))
 
 
 @wp.func
@@ -217,6 +225,8 @@ def contact_pair_kernel(
     gauss_xi: wp.array(dtype=wp.float64),
     gauss_w: wp.array(dtype=wp.float64),
     law: wp.array(dtype=wp.float64),
+    line_table: wp.array2d(dtype=wp.float64),
+    point_table: wp.array2d(dtype=wp.float64),
     # Data in:
     x_in: wp.array(dtype=wp.vec3d),
     pairs_in: wp.array(dtype=wp.vec2i),
@@ -248,29 +258,31 @@ def contact_pair_kernel(
     lb = wp.length(eb)
     ta = ea / la
     tb = eb / lb
-    # Law parameters: [k_line, m_line, beta_line, k_point, m_point, q_line, q_point, eps,
-    #                  core_fraction, hard_fraction, core_stiffness].
-    k_l = law[0]
+    # Law parameters: [K_line coef, m_line, -, K_point coef, m_point, q_line, q_point, -,
+    #                  core_fraction, hard_fraction, core_stiffness, u0, du].
     m_l = law[1]
-    beta_l = law[2]
-    k_p = law[3]
     m_p = law[4]
     q_line = law[5]
     q_point = law[6]
-    eps_rel = law[7]
     core_frac = law[8]
     hard_frac = law[9]
     core_k = law[10]
+    u0 = law[11]
+    du = law[12]
     # Pair constants from the rod's rest diameter D = r_a + r_b (``edge_law_radius``: an
-    # inflating tube keeps the stiffness of the full rod) and the harmonic-mean modulus.
+    # inflating tube keeps the stiffness of the full rod) and the harmonic-mean modulus:
+    # e_line = K_l delta^m_l with K_l = 2 k E D^2 (2D)^-m/m (contact_law), likewise K_p.
     d0 = edge_law_radius[a] + edge_law_radius[b]
     emod = f64(2.0) * edge_modulus[a] * edge_modulus[b] / (edge_modulus[a] + edge_modulus[b])
     two_d = f64(2.0) * d0
-    C_l = f64(2.0) * k_l * emod * d0 * d0 * wp.pow(two_d, -m_l) / m_l * wp.pow(
-        two_d, -f64(0.5)) / beta_l
-    al_l = m_l - f64(0.5)
-    C_p = k_p * emod * d0 * d0 * wp.pow(two_d, -m_p) / f64(3.141592653589793)
-    al_p = m_p - f64(1.0)
+    K_l = f64(2.0) * law[0] * emod * d0 * d0 * wp.pow(two_d, -m_l) / m_l
+    K_p = f64(2.0) * law[3] * emod * d0 * d0 * d0 * wp.pow(two_d, -m_p) / m_p
+    # Kernels A R^k T(rho/R): line (Abel inverse) A = K m/pi, k = m - 1; point (radial
+    # inverse) A = K m/(2 pi), k = m - 2.
+    A_l = K_l * m_l / f64(3.141592653589793)
+    k_l = m_l - f64(1.0)
+    A_p = K_p * m_p / (f64(2.0) * f64(3.141592653589793))
+    k_p = m_p - f64(2.0)
     # Stretched radii r = r0 (l/l_bar)^-nu and their derivatives in l.
     nua = edge_poisson[a]
     nub = edge_poisson[b]
@@ -308,7 +320,6 @@ def contact_pair_kernel(
         B = xi * sn
         B1 = xi1 * sn + xi * s1
         B2 = xi2 * sn + f64(2.0) * xi1 * s1 + xi * s2
-    eps = eps_rel * d0
     # Hard core (IPC barrier, Li et al. 2020, eq. 6, shifted to the hard limit): zero for
     # rho >= core, C2 there, infinite at the hard limit that the step bound guards.
     # Every point of a polyline is within 0.29 l of one of its Gauss points (2 per edge:
@@ -353,39 +364,38 @@ def contact_pair_kernel(
                 continue
             r = (xa0 + xg * ea) - (xb0 + xh * eb)
             s = wp.dot(r, r)
-            x = (R * R - s) / (f64(2.0) * R)
-            xmax = wp.max(xmax, x)
-            if x <= f64(0.0):
+            rho = wp.sqrt(s)
+            xmax = wp.max(xmax, R - rho)
+            if rho >= R:
                 continue
-            # Onset band [0, 2 eps] inside the contact: exactly zero while d >= R (surfaces
-            # apart or just touching), C2 after; shifts the law by eps (1e-4 R by default).
-            hv = positive_part(x - eps, eps)
-            Gl = power_of_ramp(hv, C_l, al_l)
-            Gp = power_of_ramp(hv, C_p, al_p)
-            Psi = A * Gl[0] + B * Gp[0]
+            u = rho / R
+            Fl = scaled_kernel(table_eval(line_table, u0, du, u), A_l, k_l, R, u)
+            Fp = scaled_kernel(table_eval(point_table, u0, du, u), A_p, k_p, R, u)
             bv = hard_core(s, rho_hard, rho_core, kcore)
-            Psi = Psi + bv[0]
+            Psi = A * Fl[0, 0] + B * Fp[0, 0] + bv[0]
             wgt = gauss_w[gi] * gauss_w[hi] * wex
             P = la * lb
             energy += wgt * P * Psi
             if want_grad == 0:
                 continue
-            Px = A * Gl[1] + B * Gp[1]
-            Pxx = A * Gl[2] + B * Gp[2]
-            Pq = A1 * Gl[0] + B1 * Gp[0]
-            Pqq = A2 * Gl[0] + B2 * Gp[0]
-            Pxq = A1 * Gl[1] + B1 * Gp[1]
-            x_s = -f64(0.5) / R
-            x_R = f64(0.5) + s / (f64(2.0) * R * R)
-            x_sR = f64(0.5) / (R * R)
-            x_RR = -s / (R * R * R)
-            Ps = Px * x_s + bv[1]
-            PR = Px * x_R
-            Pss = Pxx * x_s * x_s + bv[2]
-            PsR = Pxx * x_s * x_R + Px * x_sR
-            PRR = Pxx * x_R * x_R + Px * x_RR
-            Psq = Pxq * x_s
-            PRq = Pxq * x_R
+            # Derivatives in rho -> in s = rho^2: f_s = f_rho/(2 rho),
+            # f_ss = (f_rhorho - f_rho/rho)/(4 rho^2), f_sR = f_rhoR/(2 rho).
+            inv2r = f64(0.5) / rho
+            Ls = Fl[0, 1] * inv2r
+            Lss = (Fl[1, 0] - Fl[0, 1] / rho) / (f64(4.0) * s)
+            LsR = Fl[1, 1] * inv2r
+            Qs = Fp[0, 1] * inv2r
+            Qss = (Fp[1, 0] - Fp[0, 1] / rho) / (f64(4.0) * s)
+            QsR = Fp[1, 1] * inv2r
+            Ps = A * Ls + B * Qs + bv[1]
+            PR = A * Fl[0, 2] + B * Fp[0, 2]
+            Pss = A * Lss + B * Qss + bv[2]
+            PsR = A * LsR + B * QsR
+            PRR = A * Fl[1, 2] + B * Fp[1, 2]
+            Pq = A1 * Fl[0, 0] + B1 * Fp[0, 0]
+            Pqq = A2 * Fl[0, 0] + B2 * Fp[0, 0]
+            Psq = A1 * Ls + B1 * Qs
+            PRq = A1 * Fl[0, 2] + B1 * Fp[0, 2]
             # Psi in z = (s, l_a, l_b, q): R depends on l_a, l_b.
             Pz = wp.vec4d(Ps, PR * R_a, PR * R_b, Pq)
             Pzz = wp.mat44d(

@@ -18,24 +18,28 @@ For the pair (``w = delta/2``) the energies are the integrals of the force over 
 ``e_point(delta) = 2 k_point E D^3 (delta/2D)^(q+1)/(q+1)`` [J].
 
 Realisation on the rods (:mod:`tightknot.rods.contact_kernels`): the contact energy is a
-double integral over both centerlines of a pair kernel of the distance rho between two
-points, ``psi(rho) = C h(x)^alpha`` with ``x = (R^2 - rho^2)/(2R)``, R = r_i + r_j
-(x = delta + O(delta^2/R)), evaluated by Gauss quadrature on the edges. The kernel family
-is chosen because its integrals are exact powers of the same variable:
+double integral over both centerlines of a pair kernel psi(rho) of the distance rho between
+two points, evaluated by Gauss quadrature on the edges, with R = r_i + r_j (stretched radii)
+and delta = R - d. The kernels are the exact inverses of the laws, so that straight strands
+reproduce them at every overlap:
 
-* two parallel straight strands at distance d: integral over the second strand
-  ``int psi du = C (2R)^(-alpha) B(1/2, alpha + 1) (R^2 - d^2)^(alpha + 1/2)``
-  (Abel transform; Gradshteyn & Ryzhik 3.251.1), so ``alpha_line = p_line + 1/2`` gives
-  ``e_line`` with delta read as x exactly;
-* two straight strands crossing at angle phi: ``int int psi dA / sin(phi)
-  = (pi / sin phi) C (2R)^(-alpha) (R^2 - d^2)^(alpha + 1)/(alpha + 1)``, so
-  ``alpha_point = p_point`` and a pair weight ``sin(phi)`` give ``e_point``.
+* line: for two parallel straight strands at distance d, ``int psi(sqrt(d^2 + w^2)) dw =
+  e_line(R - d)`` is an Abel transform, inverted by
+  ``psi_l(rho) = (K m/pi) int_rho^R (R - t)^(m-1)/sqrt(t^2 - rho^2) dt
+  = (K m/pi) R^(m-1) Phi_m(rho/R)`` (Bracewell 2000, Abel pair), Phi tabulated;
+* point: two straight strands crossing at angle phi, ``int int psi dA / sin(phi) =
+  (2 pi/sin phi) int_d^R psi(t) t dt``, so with a pair weight sin(phi)
+  ``psi_p(rho) = K m (R - rho)^(m-1)/(2 pi rho)``.
+
+(A first version used powers of x = (R^2 - rho^2)/(2R) whose integrals are exact powers of
+x, not of delta: its force was the law's times d/R and vanished at full overlap, which let
+tight knots collapse; measured 13 % of the law at d = 0.13 D.)
 
 The two are blended by crossing angle (Meier, Popp, Wall 2016, "A unified approach for
 beam-to-beam contact", CMAME 315:972: line contact below ``angle_line``, point contact above
-``angle_point``, a C2 blend between). ``h(x) = H(x - eps)`` with H a C2 positive part of
-onset band [-eps, eps], eps = ``smoothing`` x R: the energy is C2 everywhere and exactly zero
-while d >= R (h(x) = x - eps beyond the band: the law is shifted by eps, 1e-4 R by default).
+``angle_point``, a C2 blend between). The tables take T at 1 - h(1 - u - b), h a C2 ramp
+of band b = 2e-3 in u = rho/R: the energy is C2 at first touch and exactly zero while
+d >= R (the law is shifted by at most 2b R = 4e-3 R).
 
 Resolution: the contact zone of a pair at overlap x has half-length sqrt(2 R x) along the
 strands; the Gauss quadrature reproduces the laws within 1 to 3 % when it spans two Gauss
@@ -70,7 +74,6 @@ class RadialComplianceLaw:
         k_area, p_area: section area under squeeze, A/A0 = (1/stretch)(1 - k (w/D)^p).
         angle_line_deg, angle_point_deg: crossing angles [deg] below which the contact is
             a line contact and above which it is a point contact.
-        smoothing: half-width of the C2 onset band of the kernel, relative to R.
         rigid: a rigid-tube law (stiff, for comparison): the outputs of a deformable
             section (width, pressure, area) are then reported as zero / unchanged.
         source: where the parameters come from.
@@ -94,12 +97,11 @@ class RadialComplianceLaw:
     p_area: float = 1.2
     angle_line_deg: float = 15.0
     angle_point_deg: float = 35.0
-    smoothing: float = 1e-4
     rigid: bool = False
     source: str = "parameters"
 
     def __post_init__(self) -> None:
-        for name in ("k_line", "k_point", "smoothing"):
+        for name in ("k_line", "k_point"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v!r}")
@@ -179,19 +181,6 @@ class RadialComplianceLaw:
         w = np.maximum(np.asarray(delta, dtype=float), 0.0) / 2.0
         return self.k_point * youngs_modulus * diameter**2 * (w / diameter) ** self.p_point
 
-    def kernel_constants(self, youngs_modulus: float, diameter: float) -> tuple[float, ...]:
-        """(C_line, alpha_line, C_point, alpha_point) of the pair kernel C h(x)^alpha
-        [J/m^(2+alpha)] for rods of rest diameter D (R = D): see the module docstring."""
-        r = diameter  # R = r_i + r_j = D for identical rods
-        m_l = self.p_line + 1.0
-        a_l = m_l - 0.5
-        beta = math.sqrt(math.pi) * math.gamma(a_l + 1.0) / math.gamma(a_l + 1.5)
-        c_l = self.line_energy_coefficient(youngs_modulus, diameter) * (2 * r) ** -0.5 / beta
-        m_p = self.p_point + 1.0
-        a_p = m_p - 1.0
-        c_p = self.point_energy_coefficient(youngs_modulus, diameter) * m_p / (math.pi * 2 * r)
-        return c_l, a_l, c_p, a_p
-
     # -- section outputs (per side, from the calibrated fits) -----------------------------
     def half_width(self, w: np.ndarray, diameter: float) -> np.ndarray:
         """Line-contact half-width b [m] at per-side approach w [m]."""
@@ -217,3 +206,57 @@ class RadialComplianceLaw:
     def _power(k: float, p: float, w: np.ndarray, diameter: float) -> np.ndarray:
         w = np.maximum(np.asarray(w, dtype=float), 0.0)
         return k * (w / diameter) ** p
+
+
+#: Kernel tables: u = rho/R from U_MIN to 1 in TABLE_INTERVALS cubic pieces; the onset band
+#: (C2 smoothing of first touch) is TABLE_BAND wide in u.
+U_MIN = 0.02
+TABLE_INTERVALS = 4096
+TABLE_BAND = 2e-3
+
+
+def _ramp(y: np.ndarray, eps: float) -> np.ndarray:
+    """C2 positive part with onset band [-eps, eps] (as contact_kernels.positive_part)."""
+    out = np.where(y >= eps, y, 0.0)
+    band = (y > -eps) & (y < eps)
+    yy = y[band] + eps
+    out[band] = yy**3 * (3 * eps - y[band]) / (16 * eps**3)
+    return out
+
+
+def abel_line_profile(m: float, u: np.ndarray) -> np.ndarray:
+    """Phi_m(u) = int_u^1 (1 - v)^(m-1) / sqrt(v^2 - u^2) dv, the Abel inverse of a line
+    energy K (R - d)^m (Bracewell 2000, "The Fourier transform", Abel pair): with
+    v = u cosh t the integrand is smooth, integrated by 200-point Gauss-Legendre."""
+    u = np.asarray(u, dtype=float)
+    tmax = np.arccosh(1.0 / np.clip(u, 1e-12, 1.0))
+    xg, wg = np.polynomial.legendre.leggauss(200)
+    t = 0.5 * (xg[None, :] + 1.0) * tmax[:, None]
+    f = np.clip(1.0 - u[:, None] * np.cosh(t), 0.0, None) ** (m - 1.0)
+    return 0.5 * tmax * (f * wg[None, :]).sum(axis=1)
+
+
+def kernel_table(kind: str, m: float) -> np.ndarray:
+    """Cubic-spline coefficients (TABLE_INTERVALS, 4) of the dimensionless kernel T(u):
+    line: T = Phi_m(u) (kernel (K m/pi) R^(m-1) T(rho/R)); point: T = (1-u)^(m-1)/u (kernel
+    K m/(2 pi) R^(m-2) T). T is taken at 1 - h(1 - u - b), h the C2 ramp of band b =
+    TABLE_BAND, so that the kernel is C2 at first touch and zero for u >= 1 (a shift of 2b R
+    = 4e-3 R of the law, at most).
+    Row j holds (a, b, c, d) of T = a + b t + c t^2 + d t^3, t = u - u_j."""
+    from scipy.interpolate import CubicSpline
+
+    u = np.linspace(U_MIN, 1.0, TABLE_INTERVALS + 1)
+    # The band lies inside the contact, [0, 2 band] in 1 - u: T(1) = 0 exactly, with zero
+    # derivatives, so first touch is continuous (a centred band made T(1) = 3 band/16 > 0,
+    # an energy jump as a Gauss pair crossed u = 1: measured, it stalled Newton).
+    ue = 1.0 - _ramp(1.0 - u - TABLE_BAND, TABLE_BAND)
+    if kind == "line":
+        vals = abel_line_profile(m, ue)
+    elif kind == "point":
+        vals = np.where(ue < 1.0, np.clip(1.0 - ue, 0, None) ** (m - 1.0) / ue, 0.0)
+    else:
+        raise ValueError(f"kind must be 'line' or 'point', got {kind!r}")
+    spl = CubicSpline(u, vals, bc_type=((1, float((vals[1] - vals[0]) / (u[1] - u[0]))),
+                                        (1, 0.0)))
+    c = spl.c  # (4, intervals), descending powers
+    return np.ascontiguousarray(np.stack([c[3], c[2], c[1], c[0]], axis=1))
