@@ -38,8 +38,8 @@ tight knots collapse; measured 13 % of the law at d = 0.13 D.)
 The two are blended by crossing angle (Meier, Popp, Wall 2016, "A unified approach for
 beam-to-beam contact", CMAME 315:972: line contact below ``angle_line``, point contact above
 ``angle_point``, a C2 blend between). The tables take T at 1 - h(1 - u - b), h a C2 ramp
-of band b = 2e-3 in u = rho/R: the energy is C2 at first touch and exactly zero while
-d >= R (the law is shifted by at most 2b R = 4e-3 R).
+of band b = 1e-3 in u = rho/R: the energy is C2 at first touch and exactly zero while
+d >= R; past the band the kernels act at delta - b R (a shift of 1e-3 R).
 
 Resolution: the contact zone of a pair at overlap x has half-length sqrt(2 R x) along the
 strands; the Gauss quadrature reproduces the laws within 1 to 3 % when it spans two Gauss
@@ -212,7 +212,7 @@ class RadialComplianceLaw:
 #: (C2 smoothing of first touch) is TABLE_BAND wide in u.
 U_MIN = 0.02
 TABLE_INTERVALS = 4096
-TABLE_BAND = 2e-3
+TABLE_BAND = 1e-3
 
 
 def _ramp(y: np.ndarray, eps: float) -> np.ndarray:
@@ -240,8 +240,8 @@ def kernel_table(kind: str, m: float) -> np.ndarray:
     """Cubic-spline coefficients (TABLE_INTERVALS, 4) of the dimensionless kernel T(u):
     line: T = Phi_m(u) (kernel (K m/pi) R^(m-1) T(rho/R)); point: T = (1-u)^(m-1)/u (kernel
     K m/(2 pi) R^(m-2) T). T is taken at 1 - h(1 - u - b), h the C2 ramp of band b =
-    TABLE_BAND, so that the kernel is C2 at first touch and zero for u >= 1 (a shift of 2b R
-    = 4e-3 R of the law, at most).
+    TABLE_BAND, so that the kernel is C2 at first touch and zero for u >= 1; beyond the band
+    T(u + b) is used, i.e. the law at delta - b R (b R = 1e-3 R).
     Row j holds (a, b, c, d) of T = a + b t + c t^2 + d t^3, t = u - u_j."""
     from scipy.interpolate import CubicSpline
 
