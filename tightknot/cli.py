@@ -119,9 +119,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     out = Path(args.out)
     summary = run_demo(out, quiet=args.quiet)
     if not args.quiet:
-        print(json.dumps({k: v for k, v in summary.items() if not isinstance(v, list)},
-                         indent=2))
-        print(f"wrote {out}/ (summary.json, figures, demo.rrd)")
+        print(json.dumps(summary, indent=2))
+        print(f"wrote {out}/ (summary.json, figures/, demo.rrd)")
     return EXIT_OK if summary.get("passed", False) else EXIT_PHYSICS
 
 
