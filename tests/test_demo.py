@@ -26,7 +26,7 @@ def test_demo_outputs(tmp_path) -> None:
     assert 9.0 < opened["lambda_oc"] < 12.4
     data = json.loads((tmp_path / "summary.json").read_text())
     assert data["knots"]["open_trefoil"]["pull_force_N"] == 5.0
-    for name in ("closed_profiles.png", "closed_contact_map.png", "open_knot.png"):
+    for name in ("closed_profiles.png", "closed_contact_map.png", "open_knots.png"):
         assert (tmp_path / "figures" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     rrd = tmp_path / "demo.rrd"
     paths = entity_paths(rrd)

@@ -106,6 +106,66 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# -- tie -------------------------------------------------------------------------------------
+_TIE_EXAMPLES = """examples:
+  tightknot tie closed --json closed.json --figures figs --rrd closed.rrd
+  tightknot tie closed --l0-over-d0 18 --nodes 200
+  tightknot tie open --length 0.185 --force 5 --json open.json
+  tightknot tie open --length 0.125 --end-distance 0.09
+"""
+
+
+def _cmd_tie(args: argparse.Namespace) -> int:
+    from tightknot.atomic import write_json_atomic
+    from tightknot.knots.run import draw_figures, run_knot
+    from tightknot.knots.scenes import closed_trefoil, open_trefoil
+    from tightknot.rods.material import Material
+    from tightknot.viz.rerun_log import make_logger
+    from tightknot.warp_setup import resolve_device
+
+    out = _writable_file(args.json)
+    rrd = _writable_file(args.rrd)
+    if args.figures is not None and not Path(args.figures).parent.exists():
+        raise ValueError(f"--figures parent folder does not exist: {Path(args.figures).parent}")
+    device = resolve_device(args.device)
+    material = Material(args.youngs_modulus, args.poisson, 1160.0)
+    if args.knot == "closed":
+        if any(v is not None for v in (args.length, args.force, args.end_distance,
+                                       args.target_lambda)):
+            raise ValueError("--length/--force/--end-distance/--target-lambda are for open knots")
+        scene = closed_trefoil(args.l0_over_d0, args.diameter, args.nodes or 200, material,
+                               device=device)
+        options: dict = {}
+    else:
+        if args.target_lambda is not None:
+            raise ValueError("--target-lambda is not supported yet: pull with --force or "
+                             "--end-distance and read lambda_oc in the JSON")
+        if (args.force is None) == (args.end_distance is None):
+            raise ValueError("give one of --force F [N] or --end-distance X [m]")
+        scene = open_trefoil(args.length if args.length is not None else 0.185, args.diameter,
+                             args.nodes or 300, material, device=device)
+        options = {"pull_force": args.force, "end_distance": args.end_distance}
+    with make_logger(rrd) as log:
+        run = run_knot(scene, log if rrd is not None else None, args.knot, [0],
+                       tighten_steps=40, pull_steps=10, **options)
+    summary = run.summary
+    if args.figures is not None:
+        draw_figures([run], Path(args.figures))
+    if out is not None:
+        write_json_atomic(out, summary)
+    if not args.quiet:
+        keys = ("knot_type", "converged", "stretch", "L_over_D", "lambda_oc", "pull_force_N",
+                "min_gap_over_D0", "min_area_ratio", "max_contact_width_fraction",
+                "max_pressure_over_E", "newton_iterations", "wall_time_s")
+        for k in keys:
+            if k in summary:
+                print(f"  {k:28s} {summary[k]}")
+    if not run.result.converged:
+        print(f"tightknot tie: failed: {run.result.failure}", file=sys.stderr)
+        return EXIT_PHYSICS
+    return EXIT_OK
+
+
 # -- demo ------------------------------------------------------------------------------------
 _DEMO_EXAMPLES = """examples:
   tightknot demo                 # writes runs/demo/
@@ -155,6 +215,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-startup", action="store_true", help="skip the start-up timing")
     p.add_argument("--device", default=None, help="Warp device (default cpu)")
     p.set_defaults(handler=_cmd_bench)
+
+    p = sub.add_parser("tie", help="tie and tighten the study's trefoils, measure them",
+                       description="Tie a closed trefoil (rest length L0 = l0/d0 D0) or an "
+                       "open trefoil (tightened, then pulled by a force or to an end-to-end "
+                       "distance) in an elastomer rod, and measure it as the study did.",
+                       epilog=_TIE_EXAMPLES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("knot", choices=["closed", "open"], help="closed or open trefoil")
+    p.add_argument("--l0-over-d0", type=float, default=16.37, help="closed: L0/D0 (16.37)")
+    p.add_argument("--length", type=float, default=None, help="open: rest length L0 [m]")
+    p.add_argument("--force", type=float, default=None, help="open: pulling force [N]")
+    p.add_argument("--end-distance", type=float, default=None,
+                   help="open: final end-to-end distance [m]")
+    p.add_argument("--target-lambda", type=float, default=None,
+                   help="open: target Lambda_OC (not supported yet)")
+    p.add_argument("--nodes", type=int, default=None, help="vertices (200 closed, 300 open)")
+    p.add_argument("--diameter", type=float, default=8.5e-3, help="rest diameter D0 [m]")
+    p.add_argument("--youngs-modulus", type=float, default=1.25e6, help="E [Pa]")
+    p.add_argument("--poisson", type=float, default=0.5, help="Poisson ratio in (-1, 0.5]")
+    p.add_argument("--json", metavar="FILE", help="write the summary as JSON")
+    p.add_argument("--figures", metavar="DIR", help="write the study's figures here")
+    p.add_argument("--rrd", metavar="FILE", help="write a rerun log of every load step")
+    p.add_argument("--device", default=None, help="Warp device (default cpu)")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.set_defaults(handler=_cmd_tie)
 
     p = sub.add_parser("demo", help="run the demo scene: figures, JSON and an .rrd",
                        description="Run the embedded demo and write its outputs to --out.",
