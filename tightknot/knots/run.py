@@ -125,6 +125,8 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
     res = tie(scene, hook=hook, **tie_options)
     x = res.system.state.x
     _, r_v = vertex_radii(scene, x, res.system.rest)
+    if scene.contact.law.rigid:
+        r_v = np.full_like(r_v, scene.diameter / 2)  # a rigid tube keeps its radius
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
                              radii=r_v)
     contact = contact_report(scene.contact, x)

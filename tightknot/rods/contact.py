@@ -129,7 +129,9 @@ class ContactLayer:
         m = model
         diam = 2.0 * m.edge_radius
         self.edge_diameter = diam
-        nu = np.array([m.rods[r].material.poisson_ratio for r in m.edge_rod])
+        # A rigid tube has a hard radius: its contact radius does not thin with stretch.
+        nu = np.array([0.0 if self.law.rigid else m.rods[r].material.poisson_ratio
+                       for r in m.edge_rod])
         emod = np.array([m.rods[r].material.youngs_modulus for r in m.edge_rod])
         self.edge_modulus = emod
         f64 = wp.float64
@@ -403,7 +405,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
     e = x[ev[:, 1]] - x[ev[:, 0]]
     le = np.linalg.norm(e, axis=1)
     stretch_e = le / rest
-    nu = np.array([m.rods[r].material.poisson_ratio for r in m.edge_rod])
+    nu = np.array([0.0 if law.rigid else m.rods[r].material.poisson_ratio for r in m.edge_rod])
     radius_e = m.edge_radius * layer.radius_scale * stretch_e ** (-nu)
     d0 = 2.0 * m.edge_radius
     wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=layer.device)

@@ -149,7 +149,8 @@ class RadialComplianceLaw:
                    source="small-strain Hertz (Johnson 1985)")
 
     def rigid_tube(self, stiffness: float = 1e3) -> RadialComplianceLaw:
-        """A rigid-tube version: ``stiffness`` times stiffer, quadratic-energy onset."""
+        """A rigid-tube version: ``stiffness`` times stiffer, with a hard radius (the contact
+        layer then keeps the rest radius instead of thinning it with stretch)."""
         return replace(self, k_line=self.k_line * stiffness, k_point=self.k_point * stiffness,
                        p_line=max(self.p_line, 1.0), p_point=max(self.p_point, 1.0),
                        rigid=True, source=f"rigid tube ({stiffness:g} x {self.source})")
