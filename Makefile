@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 # Kernel cache shared by every run and test of this checkout (compile once, reuse).
 export WARP_CACHE_PATH ?= $(CURDIR)/.warp_cache
 
-.PHONY: demo test venv lint clean
+.PHONY: demo test test-slow venv lint clean
 
 $(BIN)/tightknot: pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -18,8 +18,12 @@ venv: $(BIN)/tightknot
 demo: venv
 	$(BIN)/tightknot demo --out runs/demo
 
+# CI and `make test`: everything but the long checks (marked slow: the FEM's fine meshes).
 test: venv
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -m "not slow"
+
+test-slow: venv
+	$(BIN)/python -m pytest -q -m slow
 
 lint: venv
 	$(BIN)/ruff check .

@@ -9,7 +9,7 @@ import scipy.sparse as sp
 
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.contact import ContactLayer, SelfIntersectionError
-from tightknot.rods.contact_law import TABLE_BAND, RadialComplianceLaw
+from tightknot.rods.contact_law import RadialComplianceLaw
 from tightknot.rods.material import Material
 
 D, E = 0.0085, 1.25e6
@@ -85,7 +85,7 @@ def test_parallel_strands_follow_the_line_law(delta_over_d: float) -> None:
     f_model = -g[m.rods[1].vertex_start + 80, 2] / h
     mm = LAW.p_line + 1
     # The kernel acts at delta - b D past its onset band b (contact_law docstring).
-    eff = delta_over_d * D - TABLE_BAND * D
+    eff = delta_over_d * D - LAW.onset_band * D
     f_law = LAW.line_energy_coefficient(E, D) * mm * eff ** (mm - 1)
     assert f_model == pytest.approx(f_law, rel=0.02)
     # The same as the per-side force of the calibration at w = delta/2.
@@ -101,7 +101,7 @@ def test_crossed_strands_follow_the_point_law(delta_over_d: float) -> None:
     cl = ContactLayer(m, LAW, gauss_points=2)
     _, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
     f_model = -g[m.rods[1].vertex_slice, 2].sum()
-    f_law = float(LAW.point_force(delta_over_d * D - TABLE_BAND * D, E, D))
+    f_law = float(LAW.point_force(delta_over_d * D - LAW.onset_band * D, E, D))
     assert f_model == pytest.approx(f_law, rel=0.03)
 
 

@@ -153,10 +153,10 @@ class ContactLayer:
             core_fraction, hard_fraction, core_stiffness,
             U_MIN, (1.0 - U_MIN) / TABLE_INTERVALS,
         ], dtype=f64, device=dev)
-        self._line_table = wp.array(kernel_table("line", law_.p_line + 1.0), dtype=f64,
-                                    device=dev)
-        self._point_table = wp.array(kernel_table("point", law_.p_point + 1.0), dtype=f64,
-                                     device=dev)
+        self._line_table = wp.array(kernel_table("line", law_.p_line + 1.0, law_.onset_band),
+                                    dtype=f64, device=dev)
+        self._point_table = wp.array(kernel_table("point", law_.p_point + 1.0,
+                                                  law_.onset_band), dtype=f64, device=dev)
         self._exclusion = wp.array(exclusion_factor * diam, dtype=f64, device=dev)
         self._hard = wp.array(hard_fraction * diam, dtype=f64, device=dev)
         # Interaction range of an edge: its radius, grown if the edge is compressed

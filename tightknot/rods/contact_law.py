@@ -38,8 +38,9 @@ tight knots collapse; measured 13 % of the law at d = 0.13 D.)
 The two are blended by crossing angle (Meier, Popp, Wall 2016, "A unified approach for
 beam-to-beam contact", CMAME 315:972: line contact below ``angle_line``, point contact above
 ``angle_point``, a C2 blend between). The tables take T at 1 - h(1 - u - b), h a C2 ramp
-of band b = 1e-3 in u = rho/R: the energy is C2 at first touch and exactly zero while
-d >= R; past the band the kernels act at delta - b R (a shift of 1e-3 R).
+of band b = 1e-4 in u = rho/R (its ramp spans 7 table intervals): the energy is C2 at first
+touch and exactly zero while d >= R; past the band the kernels act at delta - b R (a shift
+of 1e-4 R: 3 % of the force at the smallest overlap the FEM cross-check uses, 0.003 D).
 
 Resolution: the contact zone of a pair at overlap x has half-length sqrt(2 R x) along the
 strands; the Gauss quadrature reproduces the laws within 1 to 3 % when it spans two Gauss
@@ -49,6 +50,7 @@ x = 0.01 D).
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from dataclasses import asdict, dataclass, replace
@@ -57,6 +59,13 @@ from pathlib import Path
 import numpy as np
 
 _LAW_FILE = Path(__file__).resolve().parents[1] / "data" / "contact_law.json"
+
+
+#: Kernel tables: u = rho/R from U_MIN to 1 in TABLE_INTERVALS cubic pieces; the onset band
+#: (C2 smoothing of first touch) is TABLE_BAND wide in u.
+U_MIN = 0.02
+TABLE_INTERVALS = 32768
+TABLE_BAND = 1e-4
 
 
 @dataclass(frozen=True)
@@ -72,6 +81,9 @@ class RadialComplianceLaw:
         k_pmax_point, p_pmax_point: point-contact peak pressure, p_max/E = k (w/D)^p.
         k_patch, p_patch: point-contact patch semi-axis, a/D = k (w/D)^p.
         k_area, p_area: section area under squeeze, A/A0 = (1/stretch)(1 - k (w/D)^p).
+        onset_band: width of the C2 onset of the kernels in u = rho/R (the law acts at
+            delta - band R): 1e-4 for the compliant law; a stiff penalty needs a smoother
+            onset (the rigid tube uses 2e-3).
         angle_line_deg, angle_point_deg: crossing angles [deg] below which the contact is
             a line contact and above which it is a point contact.
         rigid: a rigid-tube law (stiff, for comparison): the outputs of a deformable
@@ -95,6 +107,7 @@ class RadialComplianceLaw:
     p_patch: float = 0.5
     k_area: float = 1.0
     p_area: float = 1.2
+    onset_band: float = TABLE_BAND
     angle_line_deg: float = 15.0
     angle_point_deg: float = 35.0
     rigid: bool = False
@@ -111,6 +124,9 @@ class RadialComplianceLaw:
             # smooths the rest).
             if not (math.isfinite(v) and 1.0 <= v <= 6.0):
                 raise ValueError(f"{name} must be in [1, 6], got {v!r}")
+        if not (3 * (1.0 - U_MIN) / TABLE_INTERVALS <= self.onset_band <= 0.05):
+            # The ramp (2 bands wide) must span several table intervals to be resolved.
+            raise ValueError(f"onset_band must be in [1e-4, 0.05], got {self.onset_band!r}")
         if not (0.0 < self.angle_line_deg < self.angle_point_deg < 90.0):
             raise ValueError("need 0 < angle_line_deg < angle_point_deg < 90")
 
@@ -153,7 +169,8 @@ class RadialComplianceLaw:
         layer then keeps the rest radius instead of thinning it with stretch)."""
         return replace(self, k_line=self.k_line * stiffness, k_point=self.k_point * stiffness,
                        p_line=max(self.p_line, 1.0), p_point=max(self.p_point, 1.0),
-                       rigid=True, source=f"rigid tube ({stiffness:g} x {self.source})")
+                       onset_band=2e-3, rigid=True,
+                       source=f"rigid tube ({stiffness:g} x {self.source})")
 
     def as_dict(self) -> dict:
         """Parameters as a JSON-ready dict."""
@@ -209,13 +226,6 @@ class RadialComplianceLaw:
         return k * (w / diameter) ** p
 
 
-#: Kernel tables: u = rho/R from U_MIN to 1 in TABLE_INTERVALS cubic pieces; the onset band
-#: (C2 smoothing of first touch) is TABLE_BAND wide in u.
-U_MIN = 0.02
-TABLE_INTERVALS = 4096
-TABLE_BAND = 1e-3
-
-
 def _ramp(y: np.ndarray, eps: float) -> np.ndarray:
     """C2 positive part with onset band [-eps, eps] (as contact_kernels.positive_part)."""
     out = np.where(y >= eps, y, 0.0)
@@ -237,12 +247,14 @@ def abel_line_profile(m: float, u: np.ndarray) -> np.ndarray:
     return 0.5 * tmax * (f * wg[None, :]).sum(axis=1)
 
 
-def kernel_table(kind: str, m: float) -> np.ndarray:
+@functools.lru_cache(maxsize=16)
+def kernel_table(kind: str, m: float, band: float = TABLE_BAND) -> np.ndarray:
     """Cubic-spline coefficients (TABLE_INTERVALS, 4) of the dimensionless kernel T(u):
     line: T = Phi_m(u) (kernel (K m/pi) R^(m-1) T(rho/R)); point: T = (1-u)^(m-1)/u (kernel
-    K m/(2 pi) R^(m-2) T). T is taken at 1 - h(1 - u - b), h the C2 ramp of band b =
-    TABLE_BAND, so that the kernel is C2 at first touch and zero for u >= 1; beyond the band
-    T(u + b) is used, i.e. the law at delta - b R (b R = 1e-3 R).
+    K m/(2 pi) R^(m-2) T). T is taken at 1 - h(1 - u - b), h the C2 ramp of band b
+    (``band``, default TABLE_BAND), so that the kernel is C2 at first touch and zero for
+    u >= 1; beyond the band T(u + b) is used, i.e. the law at delta - b R. Cached per
+    (kind, m, band): the returned array must not be modified.
     Row j holds (a, b, c, d) of T = a + b t + c t^2 + d t^3, t = u - u_j."""
     from scipy.interpolate import CubicSpline
 
@@ -250,7 +262,7 @@ def kernel_table(kind: str, m: float) -> np.ndarray:
     # The band lies inside the contact, [0, 2 band] in 1 - u: T(1) = 0 exactly, with zero
     # derivatives, so first touch is continuous (a centred band made T(1) = 3 band/16 > 0,
     # an energy jump as a Gauss pair crossed u = 1: measured, it stalled Newton).
-    ue = 1.0 - _ramp(1.0 - u - TABLE_BAND, TABLE_BAND)
+    ue = 1.0 - _ramp(1.0 - u - band, band)
     if kind == "line":
         vals = abel_line_profile(m, ue)
     elif kind == "point":
