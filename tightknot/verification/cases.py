@@ -209,31 +209,38 @@ def michell_instability(device: str = "cpu") -> list[VerifyRow]:
     GJ/EI = 1/(1 + nu) is varied through nu to find where the lowest non-rigid eigenvalue
     of the Hessian crosses zero; within 2 %."""
     t0 = time.perf_counter()
-    n, radius, link = 48, 0.1, 2
-    phi = 2 * math.pi * np.arange(n) / n
-    pts = np.c_[radius * np.cos(phi), radius * np.sin(phi), np.zeros(n)]
+    radius, link = 0.1, 2
 
-    def lowest(nu: float) -> float:
-        b = RodBuilder()
-        b.add_rod(pts, diameter=DIAMETER, material=Material(MODULUS, nu, 1000.0), closed=True,
-                  link_offset=link)
-        model = b.finalize(device)
-        sys_ = RodSystem(model, State.initial(model))
-        res = newton_solve(sys_, sys_.free_vector())
-        if not res.converged:
-            raise RuntimeError("twisted ring did not converge")
-        _, _, h = sys_.evaluate(sys_.free_vector(), True, True)
-        v = _rigid_modes(model, sys_.state, sys_.pattern.free_dofs)
-        # Orthonormal basis of the complement of the rigid modes.
-        qfull, _ = np.linalg.qr(np.c_[v, np.eye(v.shape[0])])
-        q = qfull[:, v.shape[1]:]
-        hd = h.toarray()
-        return float(np.linalg.eigvalsh(q.T @ hd @ q)[0])
+    def threshold(n: int) -> float:
+        phi = 2 * math.pi * np.arange(n) / n
+        pts = np.c_[radius * np.cos(phi), radius * np.sin(phi), np.zeros(n)]
 
-    nu_c = brentq(lowest, -0.3, 0.45, xtol=1e-8)
-    got = (1.0 / (1.0 + nu_c)) * link  # GJ tau L/(2 pi EI) at the threshold
-    # 2 % is the issue's target: the discrete ring with 48 vertices is O(1/N^2) ~ 4e-3 off.
-    return [_row("michell_twisted_ring", math.sqrt(3.0), got, 2e-2, t0=t0)]
+        def lowest(nu: float) -> float:
+            b = RodBuilder()
+            b.add_rod(pts, diameter=DIAMETER, material=Material(MODULUS, nu, 1000.0),
+                      closed=True, link_offset=link)
+            model = b.finalize(device)
+            sys_ = RodSystem(model, State.initial(model))
+            res = newton_solve(sys_, sys_.free_vector())
+            if not res.converged:
+                raise RuntimeError("twisted ring did not converge")
+            _, _, h = sys_.evaluate(sys_.free_vector(), True, True)
+            v = _rigid_modes(model, sys_.state, sys_.pattern.free_dofs)
+            # Orthonormal basis of the complement of the rigid modes.
+            qfull, _ = np.linalg.qr(np.c_[v, np.eye(v.shape[0])])
+            q = qfull[:, v.shape[1]:]
+            return float(np.linalg.eigvalsh(q.T @ h.toarray() @ q)[0])
+
+        nu_c = brentq(lowest, -0.3, 0.45, xtol=1e-8)
+        return (1.0 / (1.0 + nu_c)) * link  # GJ tau L/(2 pi EI) at the threshold
+
+    ref = math.sqrt(3.0)
+    coarse, fine = threshold(48), threshold(96)
+    e_c, e_f = abs(coarse - ref) / ref, abs(fine - ref) / ref
+    order = math.log2(e_c / e_f)
+    # 2 % is the issue's target; the discrete ring converges at second order (measured
+    # 5.6 %, 1.4 %, 0.33 % at 24, 48, 96 vertices), so 96 vertices are well inside it.
+    return [_row("michell_twisted_ring n=96", ref, fine, 2e-2, order=order, t0=t0)]
 
 
 def neo_hookean_stretch(device: str = "cpu") -> list[VerifyRow]:
