@@ -313,30 +313,35 @@ class ContactLayer:
         return wp.array(0.5 * self.hard_fraction * self.edge_diameter * self.radius_scale,
                         dtype=wp.float64, device=self.device)
 
-    def check_no_intersection(self, x: np.ndarray) -> None:
-        """Refuse positions whose non-local segments are closer than the hard limit,
-        saying where (rest arc lengths of the offending pair)."""
+    def _pair_distances(self, x: np.ndarray, margin: wp.array) -> tuple[np.ndarray, ...]:
+        """Non-local candidate edge pairs within ``margin`` bounds and their segment
+        distances [m]; also the rest arcs of the edges."""
         dev = self.device
         wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
         arcs, rod_len = self._arcs(self.rest)
-        pairs = self._candidates(wx, self._zero_dx, self._half_hard(), arcs, rod_len)
+        pairs = self._candidates(wx, self._zero_dx, margin, arcs, rod_len)
         n = pairs.shape[0]
         if n == 0:
-            return
+            return np.zeros((0, 2), dtype=np.int32), np.zeros(0), arcs.numpy()
         alpha = wp.zeros(n, dtype=wp.float64, device=dev)
         dist = wp.zeros(n, dtype=wp.float64, device=dev)
         wp.launch(ck.step_bound_kernel, dim=n, device=dev,
                   inputs=[self._edge_vertex, wx, self._zero_dx, pairs, self._hard],
                   outputs=[alpha, dist])
-        d = dist.numpy()
-        pr = pairs.numpy()
+        return pairs.numpy(), dist.numpy(), arcs.numpy()
+
+    def check_no_intersection(self, x: np.ndarray) -> None:
+        """Refuse positions whose non-local segments are closer than the hard limit,
+        saying where (rest arc lengths of the offending pair)."""
+        pr, d, ar = self._pair_distances(x, self._half_hard())
+        if not d.size:
+            return
         dh = self.hard_fraction * self.edge_diameter * self.radius_scale
         hard = np.maximum(dh[pr[:, 0]], dh[pr[:, 1]])
         bad = np.flatnonzero(d < hard)
         if bad.size:
             k = bad[np.argmin(d[bad] / hard[bad])]
             a, b = pr[k]
-            ar = arcs.numpy()
             raise SelfIntersectionError(
                 f"the rods intersect themselves: edges {a} and {b} (rest arc lengths "
                 f"{ar[a][0]:.6g}..{ar[a][1]:.6g} m and {ar[b][0]:.6g}..{ar[b][1]:.6g} m) are "
@@ -346,23 +351,11 @@ class ContactLayer:
     def min_distance(self, x: np.ndarray) -> tuple[float, int, int]:
         """Smallest non-local segment distance [m] among pairs within the interaction
         range, and its edge pair (inf, -1, -1 when none)."""
-        dev = self.device
-        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
-        arcs, rod_len = self._arcs(self.rest)
-        pairs = self._candidates(wx, self._zero_dx, self._margin, arcs, rod_len)
-        n = pairs.shape[0]
-        if n == 0:
+        pr, d, _ = self._pair_distances(x, self._margin)
+        if not d.size:
             return math.inf, -1, -1
-        alpha = wp.zeros(n, dtype=wp.float64, device=dev)
-        dist = wp.zeros(n, dtype=wp.float64, device=dev)
-        wp.launch(ck.step_bound_kernel, dim=n, device=dev,
-                  inputs=[self._edge_vertex, wx, self._zero_dx, pairs, self._hard],
-                  outputs=[alpha, dist])
-        d = dist.numpy()
         k = int(np.argmin(d))
-        pr = pairs.numpy()
         return float(d[k]), int(pr[k][0]), int(pr[k][1])
-
 
 def _segment_closest(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
                      q1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
