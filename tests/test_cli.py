@@ -80,4 +80,5 @@ def test_tie_bad_input_exit_2(tmp_path) -> None:
     assert main(["tie", "open", "--force", "5", "--json", "/no/such/dir/x.json"]) == 2
     assert main(["tie", "closed", "--nodes", "5"]) == 2
     assert main(["tie", "closed", "--poisson", "0.7"]) == 2
-    assert main(["tie", "open", "--target-lambda", "10.1"]) == 2
+    assert main(["tie", "open", "--target-lambda", "10.1", "--force", "3"]) == 2
+    assert main(["tie", "open", "--target-lambda", "-1"]) == 2

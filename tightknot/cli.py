@@ -110,8 +110,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 _TIE_EXAMPLES = """examples:
   tightknot tie closed --json closed.json --figures figs --rrd closed.rrd
   tightknot tie closed --l0-over-d0 18 --nodes 200
-  tightknot tie open --length 0.185 --force 5 --json open.json
-  tightknot tie open --length 0.125 --end-distance 0.09
+  tightknot tie open --length 0.185 --target-lambda 15.0 --json open.json
+  tightknot tie open --length 0.125 --target-lambda 10.1 --figures figs
+  tightknot tie open --length 0.185 --force 5
 """
 
 
@@ -137,14 +138,16 @@ def _cmd_tie(args: argparse.Namespace) -> int:
                                device=device)
         options: dict = {}
     else:
-        if args.target_lambda is not None:
-            raise ValueError("--target-lambda is not supported yet: pull with --force or "
-                             "--end-distance and read lambda_oc in the JSON")
-        if (args.force is None) == (args.end_distance is None):
-            raise ValueError("give one of --force F [N] or --end-distance X [m]")
+        given = [v is not None for v in (args.force, args.end_distance, args.target_lambda)]
+        if sum(given) != 1:
+            raise ValueError("give one of --force F [N], --end-distance X [m] or "
+                             "--target-lambda LAMBDA")
+        if args.target_lambda is not None and not (0 < args.target_lambda < 1e3):
+            raise ValueError(f"--target-lambda must be in (0, 1000), got {args.target_lambda}")
         scene = open_trefoil(args.length if args.length is not None else 0.185, args.diameter,
                              args.nodes or 300, material, device=device)
-        options = {"pull_force": args.force, "end_distance": args.end_distance}
+        options = ({"target_lambda": args.target_lambda} if args.target_lambda is not None
+                   else {"pull_force": args.force, "end_distance": args.end_distance})
     with make_logger(rrd) as log:
         run = run_knot(scene, log if rrd is not None else None, args.knot, [0],
                        tighten_steps=40, pull_steps=10, **options)
@@ -229,7 +232,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--end-distance", type=float, default=None,
                    help="open: final end-to-end distance [m]")
     p.add_argument("--target-lambda", type=float, default=None,
-                   help="open: target Lambda_OC (not supported yet)")
+                   help="open: pull until Lambda_OC reaches this (within 0.1)")
     p.add_argument("--nodes", type=int, default=None, help="vertices (200 closed, 300 open)")
     p.add_argument("--diameter", type=float, default=8.5e-3, help="rest diameter D0 [m]")
     p.add_argument("--youngs-modulus", type=float, default=1.25e6, help="E [Pa]")

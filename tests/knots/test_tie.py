@@ -76,3 +76,20 @@ def test_rigid_tube_keeps_its_diameter_and_the_knot_stays_ideal_length() -> None
     assert set(run.result.knot_types) == {"3_1"}
     assert run.summary["min_gap_over_D0"] > 0.98
     assert run.summary["lambda_oc"] is not None and run.summary["lambda_oc"] > 12.0
+
+
+def test_the_study_open_knots_reach_their_target_lengths() -> None:
+    # physics.md sec. 1: L0 = 185 mm pulled to Lambda_OC = 15.0 and L0 = 125 mm to 10.1;
+    # the issue asks for the target within 0.2 (the search stops within 0.1). Forces
+    # measured: 1.77 N and 6.08 N; the tighter knot needs the larger force.
+    from tightknot.knots.tie import lambda_oc, tie_to_lambda
+
+    forces = []
+    for length, target, nodes in ((0.185, 15.0, 150), (0.125, 10.1, 100)):
+        scene = open_trefoil(rest_length=length, nodes=nodes)
+        res = tie_to_lambda(scene, target)
+        assert res.converged, res.failure
+        assert set(res.knot_types) == {"3_1"}
+        assert abs(lambda_oc(res.system.state.x, scene.diameter) - target) <= 0.2
+        forces.append(res.pull_force_N)
+    assert forces[1] > forces[0] > 0

@@ -17,7 +17,7 @@ from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal import load_ideal_trefoil
 from tightknot.knots.measure import analyze_centerline
 from tightknot.knots.scenes import KnotScene
-from tightknot.knots.tie import TieResult, tie
+from tightknot.knots.tie import TieResult, tie, tie_to_lambda
 from tightknot.rods.contact import ContactReport, contact_report
 from tightknot.solvers.system import RodSystem
 
@@ -122,7 +122,11 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
     hook = None
     if log is not None:
         hook = logging_hook(log, scene, name or scene.name, counter if counter else [0])
-    res = tie(scene, hook=hook, **tie_options)
+    target = tie_options.pop("target_lambda", None)
+    if target is not None:
+        res = tie_to_lambda(scene, target, hook=hook)
+    else:
+        res = tie(scene, hook=hook, **tie_options)
     x = res.system.state.x
     _, r_v = vertex_radii(scene, x, res.system.rest)
     if scene.contact.law.rigid:
