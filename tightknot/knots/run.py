@@ -16,10 +16,13 @@ from tightknot.knots import figures
 from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal import load_ideal_trefoil
 from tightknot.knots.measure import analyze_centerline
-from tightknot.knots.scenes import KnotScene
+from tightknot.knots.scenes import KnotScene, vertex_radii
 from tightknot.knots.tie import TieResult, tie, tie_to_lambda
 from tightknot.rods.contact import ContactReport, contact_report
 from tightknot.solvers.system import RodSystem
+
+#: Contact tolerance of the measurements (the default of tightknot.knots.measure).
+CONTACT_TOL = 0.01
 
 
 @dataclass
@@ -32,20 +35,6 @@ class KnotRun:
     report: dict
     contact: ContactReport
     summary: dict
-
-
-def vertex_radii(scene: KnotScene, x: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Deformed edge radii r0 lam^-nu [m] and their vertex averages [m]."""
-    m = scene.model
-    ev = m.edge_vertex
-    lam = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1) / rest
-    nu = m.rods[0].material.poisson_ratio
-    r_e = m.edge_radius * lam ** (-nu)
-    r_v = np.zeros(m.vertex_count)
-    cnt = np.zeros(m.vertex_count)
-    np.add.at(r_v, ev.ravel(), np.repeat(r_e, 2))
-    np.add.at(cnt, ev.ravel(), 1.0)
-    return r_e, r_v / np.maximum(cnt, 1.0)
 
 
 def logging_hook(log: Any, scene: KnotScene, name: str, counter: list[int]):
@@ -129,10 +118,11 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
         res = tie(scene, hook=hook, **tie_options)
     x = res.system.state.x
     _, r_v = vertex_radii(scene, x, res.system.rest)
-    if scene.contact.law.rigid:
-        r_v = np.full_like(r_v, scene.diameter / 2)  # a rigid tube keeps its radius
+    # Contact as physics.md sec. 2 defines it for a rod model: distance at most the sum of
+    # the deformed radii; the measurement's 1 % tolerance covers the vertex sampling of the
+    # centerline (segments touch between vertices) and the contact law's onset band.
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
-                             radii=r_v)
+                             radii=r_v, contact_tol=CONTACT_TOL)
     contact = contact_report(scene.contact, x)
     return KnotRun(scene, res, rep, contact, summarise(scene, res, rep, contact))
 

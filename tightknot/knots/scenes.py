@@ -198,3 +198,18 @@ def bending_force_scale(scene: KnotScene) -> float:
     """EI/D0^2 [N], the force scale of a knot made of this rod."""
     mat = scene.model.rods[0].material
     return mat.youngs_modulus * math.pi * scene.diameter**4 / 64.0 / scene.diameter**2
+
+
+def vertex_radii(scene: KnotScene, x: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Deformed edge radii r0 lam^-nu [m] (the rest radius for a rigid tube) and their
+    vertex averages [m], for centerline ``x`` and edge rest lengths ``rest``."""
+    m = scene.model
+    ev = m.edge_vertex
+    lam = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1) / rest
+    nu = 0.0 if scene.contact.law.rigid else m.rods[0].material.poisson_ratio
+    r_e = m.edge_radius * lam ** (-nu)
+    r_v = np.zeros(m.vertex_count)
+    cnt = np.zeros(m.vertex_count)
+    np.add.at(r_v, ev.ravel(), np.repeat(r_e, 2))
+    np.add.at(cnt, ev.ravel(), 1.0)
+    return r_e, r_v / np.maximum(cnt, 1.0)

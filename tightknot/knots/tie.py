@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tightknot.knots import topology
-from tightknot.knots.scenes import KnotScene, bending_force_scale, end_vertex
+from tightknot.knots.scenes import KnotScene, bending_force_scale, end_vertex, vertex_radii
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.solvers.newton import NewtonOptions, newton_solve
 from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord, solve_static
@@ -250,14 +250,16 @@ def _copy_gauge(scene: KnotScene, positions: np.ndarray | None = None,
     return bcs
 
 
-def lambda_oc(x: np.ndarray, diameter: float, radii: np.ndarray | float | None = None) -> float:
+def lambda_oc(x: np.ndarray, diameter: float, radii: np.ndarray | float | None = None,
+              tol: float = 0.01) -> float:
     """Open-knot length Lambda_OC of centerline ``x`` (physics.md sec. 2), NaN without
-    contact; contact where the distance is at most the sum of the radii (default D0/2)."""
+    contact; contact where the distance is at most (1 + tol) times the sum of the radii
+    (default D0/2; pass the deformed radii of a simulation, as the summaries do)."""
     from tightknot.knots.contact_map import contact_pairs
     from tightknot.knots.open_measures import open_knot_measures
 
     r = np.full(len(x), diameter / 2) if radii is None else radii
-    i, j = contact_pairs(x, False, r, tol=0.0)
+    i, j = contact_pairs(x, False, r, tol=tol)
     s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
     return float(open_knot_measures(np.unique(np.r_[i, j]), s, diameter)["Lambda_OC"])
 
@@ -320,7 +322,8 @@ def tie_to_lambda(
         if kt != scene.knot_type:
             return False, math.nan, (f"knot type {kt} at force {f:.4g} N (the knot slipped "
                                      "off an end, or the rod passed through itself)")
-        return True, lambda_oc(pull.state.x, scene.diameter), ""
+        x = pull.state.x
+        return True, lambda_oc(x, scene.diameter, vertex_radii(scene, x, pull.rest)[1]), ""
 
     def done(ok: bool, msg: str) -> TieResult:
         return TieResult(ok, msg, res.phases, iters, res.wall_time_s + time.perf_counter()
