@@ -139,7 +139,6 @@ class ContactLayer:
         self._edge_rod = wp.array(m.edge_rod, dtype=wp.int32, device=dev)
         self._rod_closed = wp.array([int(r.closed) for r in m.rods], dtype=wp.int32, device=dev)
         self._radius0 = wp.array(m.edge_radius, dtype=f64, device=dev)
-        self._law_radius = wp.array(m.edge_radius, dtype=f64, device=dev)
         self._poisson = wp.array(nu, dtype=f64, device=dev)
         self._modulus = wp.array(emod, dtype=f64, device=dev)
         xi, w = _GAUSS[gauss_points]
@@ -164,9 +163,6 @@ class ContactLayer:
         # Gauss points can interact (distance < r_a + r_b) have overlapping bounds.
         self._margin = wp.array(_MARGIN * m.edge_radius, dtype=f64, device=dev)
         self._zero_dx = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
-        self.radius_scale = 1.0
-        #: Optional schedule t -> contact radius scale along a load path (inflation).
-        self.radius_schedule = None
         self._capacity = int(initial_capacity)
         self._alloc(self._capacity)
         self.last_pairs = np.zeros((0, 2), dtype=np.int32)
@@ -174,27 +170,6 @@ class ContactLayer:
         #: Edge rest lengths of the last evaluation (the load path changes them): the
         #: exclusion window of the step bound and of the checks is measured with these.
         self.rest = model.edge_rest_length.copy()
-
-    # -- load path -------------------------------------------------------------------------
-    def set_radius_scale(self, scale: float) -> None:
-        """Scale the contact radii of every edge (the tube inflated or thinned), (0, 1].
-
-        Only the geometry shrinks: the law keeps the stiffness of the full rod, so a thin
-        tube is not squeezed through by the bending forces of the full one.
-        """
-        if not (math.isfinite(scale) and 0.0 < scale <= 1.0):
-            raise ValueError(f"radius scale must be in (0, 1], got {scale!r}")
-        self.radius_scale = float(scale)
-        dev = self.device
-        r = self.model.edge_radius * scale
-        self._radius0 = wp.array(r, dtype=wp.float64, device=dev)
-        self._hard = wp.array(self.hard_fraction * 2.0 * r, dtype=wp.float64, device=dev)
-        self._margin = wp.array(_MARGIN * r, dtype=wp.float64, device=dev)
-
-    def set_load(self, t: float) -> None:
-        """Follow the radius schedule (if any) at load parameter t."""
-        if self.radius_schedule is not None:
-            self.set_radius_scale(float(self.radius_schedule(t)))
 
     # -- buffers and detection -------------------------------------------------------------
     def _alloc(self, capacity: int) -> None:
@@ -262,7 +237,7 @@ class ContactLayer:
         wrest = wp.array(np.ascontiguousarray(rest), dtype=wp.float64, device=dev)
         wp.launch(ck.contact_pair_kernel, dim=npairs, device=dev,
                   inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, self._radius0,
-                          self._law_radius, self._poisson, self._modulus, self._gxi, self._gw,
+                          self._poisson, self._modulus, self._gxi, self._gw,
                           self._law, self._line_table, self._point_table, wx, pairs, wrest,
                           arcs, rod_len, self._exclusion,
                           int(want_grad or want_hess), int(want_hess)],
@@ -310,7 +285,7 @@ class ContactLayer:
         return float(np.clip(alpha.numpy().min(), 0.0, 1.0))
 
     def _half_hard(self) -> wp.array:
-        return wp.array(0.5 * self.hard_fraction * self.edge_diameter * self.radius_scale,
+        return wp.array(0.5 * self.hard_fraction * self.edge_diameter,
                         dtype=wp.float64, device=self.device)
 
     def _pair_distances(self, x: np.ndarray, margin: wp.array) -> tuple[np.ndarray, ...]:
@@ -336,7 +311,7 @@ class ContactLayer:
         pr, d, ar = self._pair_distances(x, self._half_hard())
         if not d.size:
             return
-        dh = self.hard_fraction * self.edge_diameter * self.radius_scale
+        dh = self.hard_fraction * self.edge_diameter
         hard = np.maximum(dh[pr[:, 0]], dh[pr[:, 1]])
         bad = np.flatnonzero(d < hard)
         if bad.size:
@@ -399,7 +374,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
     le = np.linalg.norm(e, axis=1)
     stretch_e = le / rest
     nu = np.array([0.0 if law.rigid else m.rods[r].material.poisson_ratio for r in m.edge_rod])
-    radius_e = m.edge_radius * layer.radius_scale * stretch_e ** (-nu)
+    radius_e = m.edge_radius * stretch_e ** (-nu)
     d0 = 2.0 * m.edge_radius
     wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=layer.device)
     arcs, rod_len = layer._arcs(rest)

@@ -219,7 +219,6 @@ def contact_pair_kernel(
     edge_rod: wp.array(dtype=wp.int32),
     rod_closed: wp.array(dtype=wp.int32),
     edge_radius0: wp.array(dtype=wp.float64),
-    edge_law_radius: wp.array(dtype=wp.float64),
     edge_poisson: wp.array(dtype=wp.float64),
     edge_modulus: wp.array(dtype=wp.float64),
     gauss_xi: wp.array(dtype=wp.float64),
@@ -269,10 +268,9 @@ def contact_pair_kernel(
     core_k = law[10]
     u0 = law[11]
     du = law[12]
-    # Pair constants from the rod's rest diameter D = r_a + r_b (``edge_law_radius``: an
-    # inflating tube keeps the stiffness of the full rod) and the harmonic-mean modulus:
+    # Pair constants from the rest diameter D = r_a + r_b and the harmonic-mean modulus:
     # e_line = K_l delta^m_l with K_l = 2 k E D^2 (2D)^-m/m (contact_law), likewise K_p.
-    d0 = edge_law_radius[a] + edge_law_radius[b]
+    d0 = edge_radius0[a] + edge_radius0[b]
     emod = f64(2.0) * edge_modulus[a] * edge_modulus[b] / (edge_modulus[a] + edge_modulus[b])
     two_d = f64(2.0) * d0
     K_l = f64(2.0) * law[0] * emod * d0 * d0 * wp.pow(two_d, -m_l) / m_l
@@ -326,10 +324,9 @@ def contact_pair_kernel(
     # 0.577 l apart inside an edge, 0.42 l across a vertex; 3 per edge: closer), so the
     # barrier diverges at rho_hard = hard + 0.58 l_max: it stops two segments before their
     # distance reaches the step bound's hard limit, whatever Gauss points they hold.
-    dgeo = edge_radius0[a] + edge_radius0[b]
     lmax = wp.max(edge_rest_length_in[a], edge_rest_length_in[b])
-    rho_hard = hard_frac * dgeo + f64(0.58) * lmax
-    rho_core = rho_hard + (core_frac - hard_frac) * dgeo
+    rho_hard = hard_frac * d0 + f64(0.58) * lmax
+    rho_core = rho_hard + (core_frac - hard_frac) * d0
     kcore = core_k * emod * d0
     ng = gauss_xi.shape[0]
     ra_ = edge_rod[a]

@@ -143,10 +143,6 @@ class RodSystem:
         if self.gravity is not None:
             f = f + self.model.vertex_mass[:, None] * self.gravity[None, :]
         self.f_ext = f
-        for term in self.extra_terms:
-            hook = getattr(term, "set_load", None)
-            if hook is not None:
-                hook(self.t)
         st = self.state
         # External work is measured from the positions at this load step, so that its
         # round-off stays that of the displacements, not of the coordinates.
