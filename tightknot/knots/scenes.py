@@ -48,7 +48,6 @@ class KnotScene:
         start_length_ratio: rest length of the start over L0 (>= 1; the model's edge rest
             lengths are those of the start, scaled by 1/ratio when tying).
         pull_axis: unit pull axis of an open knot (its ends lie on it), else None.
-        gauge: the boundary conditions of the start (gauge fixing, sliding end).
         knot_type: the expected knot type ("3_1").
     """
 
@@ -61,7 +60,6 @@ class KnotScene:
     closed: bool
     start_length_ratio: float
     pull_axis: np.ndarray | None
-    gauge: BoundaryConditions
     knot_type: str = "3_1"
     info: dict = field(default_factory=dict)
 
@@ -122,13 +120,9 @@ def closed_trefoil(
     b.add_rod(pts, d0, material or STUDY_MATERIAL, closed=True)
     model = b.finalize(device)
     state = State.initial(model)
-    gauge = (BoundaryConditions(model).pin(0, 0).fix_components(0, n // 3, (1, 2))
-             .fix_components(0, 2 * n // 3, (2,)))
-    if twist:
-        gauge.fix_twist(0, 0)  # the uniform-twist rotation is a zero mode
     contact = ContactLayer(model, law)
     return KnotScene("closed_trefoil", model, state, contact, d0, ratio * d0, True, grow,
-                     None, gauge, info={"l0_over_d0": ratio})
+                     None, info={"l0_over_d0": ratio})
 
 
 def open_trefoil(
@@ -181,12 +175,30 @@ def open_trefoil(
     b.add_rod(pts, d0, material or STUDY_MATERIAL, closed=False)
     model = b.finalize(device)
     state = State.initial(model)
-    gauge = (BoundaryConditions(model).pin(0, 0).fix_components(0, -1, (1, 2))
-             .fix_components(0, far, (2,)))
     contact = ContactLayer(model, law)
     return KnotScene("open_trefoil", model, state, contact, d0, l0, False, grow,
-                     np.array([1.0, 0.0, 0.0]), gauge,
+                     np.array([1.0, 0.0, 0.0]),
                      info={"gauge_vertex": far, "tail_fraction": tail_fraction})
+
+
+def gauge(scene: KnotScene, positions: np.ndarray | None = None,
+          sliding_end: bool = True) -> BoundaryConditions:
+    """The scene's force-free gauge (module docstring) at ``positions`` (default the start):
+    first vertex pinned; closed knots fix two more vertices' coordinates that a rigid
+    rotation would move and the uniform twist; open knots let the last end slide along the
+    pull axis (``sliding_end``) and fix the z of the vertex farthest from the axis."""
+    model = scene.model
+    bcs = BoundaryConditions(model, positions).pin(0, 0)
+    if scene.closed:
+        n = model.vertex_count
+        bcs.fix_components(0, n // 3, (1, 2)).fix_components(0, 2 * n // 3, (2,))
+        if model.twist:
+            bcs.fix_twist(0, 0)  # the uniform-twist rotation is a zero mode
+        return bcs
+    if sliding_end:
+        bcs.fix_components(0, -1, (1, 2))
+    bcs.fix_components(0, scene.info["gauge_vertex"], (2,))
+    return bcs
 
 
 def end_vertex(scene: KnotScene) -> int:

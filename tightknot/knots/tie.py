@@ -19,8 +19,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tightknot.knots import topology
-from tightknot.knots.scenes import KnotScene, bending_force_scale, end_vertex, vertex_radii
-from tightknot.rods.boundary import BoundaryConditions
+from tightknot.knots.scenes import (
+    KnotScene,
+    bending_force_scale,
+    end_vertex,
+    gauge,
+    vertex_radii,
+)
 from tightknot.solvers.newton import NewtonOptions, newton_solve
 from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord, solve_static
 from tightknot.solvers.system import RodSystem
@@ -131,7 +136,7 @@ def tie(
     # The start curve is not an equilibrium: relax it first (an open knot's end sliding
     # under a small tension, so the loose loops do not swing freely), with a budget for the
     # long, floppy path of a loose knot (measured: 150 iterations for 150 vertices).
-    bcs = _copy_gauge(scene)
+    bcs = gauge(scene)
     if not scene.closed:
         bcs.force(0, last, lambda t: hold * axis)
     system = RodSystem(model, scene.state, bcs)
@@ -148,12 +153,12 @@ def tie(
     if kt != scene.knot_type:
         return fail(f"relax: knot type {kt}, expected {scene.knot_type}", system, hold)
     if scene.closed:
-        bcs = _copy_gauge(scene, positions=system.state.x)
+        bcs = gauge(scene, positions=system.state.x)
     else:
         # The end then follows the shrink (end-to-end distance scaled with the rest
         # length): with a freely sliding end the tail slides out of the shrinking loop and
         # the knot slips off the rod (measured: knot type 0_1 at 55 % of the path).
-        bcs = _copy_gauge(scene, positions=system.state.x, sliding_end=False)
+        bcs = gauge(scene, positions=system.state.x, sliding_end=False)
         span = float(system.state.x[last] @ axis)
         bcs.pin(0, last, translation=lambda t: (shrink - 1.0) * t * span * axis)
     bcs.rest_length_scale((1.0, shrink))
@@ -180,7 +185,7 @@ def tie(
 
     # Phase 2: pull.
     state = system.state
-    bcs = _copy_gauge(scene, positions=state.x)
+    bcs = gauge(scene, positions=state.x)
     bcs.rest_length_scale((shrink, shrink))
     if pull_force is not None:
         # Start from the force the pinned end carried at the end of the tightening (a jump
@@ -195,7 +200,7 @@ def tie(
     else:
         d_now = float(np.linalg.norm(state.x[last] - state.x[0]))
         delta = end_distance - d_now
-        bcs = _copy_gauge(scene, positions=state.x, sliding_end=False)
+        bcs = gauge(scene, positions=state.x, sliding_end=False)
         bcs.rest_length_scale((shrink, shrink))
         bcs.pin(0, last, translation=delta * axis)
         final_force = math.nan
@@ -228,26 +233,6 @@ def end_reaction(system: RodSystem) -> float:
         _, gk, _ = term.evaluate(x, system.rest, True, False)
         g += gk[-1]
     return float(g[0])
-
-
-def _copy_gauge(scene: KnotScene, positions: np.ndarray | None = None,
-                sliding_end: bool = True) -> BoundaryConditions:
-    """The scene's gauge (pinned first end, sliding last end, rotation gauge) anew, at the
-    current positions (a BoundaryConditions keeps the positions it was built with)."""
-    model = scene.model
-    if positions is not None:
-        model.vertex_initial_position = positions.copy()
-    bcs = BoundaryConditions(model).pin(0, 0)
-    if scene.closed:
-        n = model.vertex_count
-        bcs.fix_components(0, n // 3, (1, 2)).fix_components(0, 2 * n // 3, (2,))
-        if model.twist:
-            bcs.fix_twist(0, 0)
-        return bcs
-    if sliding_end:
-        bcs.fix_components(0, -1, (1, 2))
-    bcs.fix_components(0, scene.info["gauge_vertex"], (2,))
-    return bcs
 
 
 def lambda_oc(x: np.ndarray, diameter: float, radii: np.ndarray | float | None = None,
@@ -295,7 +280,7 @@ def tie_to_lambda(
     last = end_vertex(scene)
     axis = scene.pull_axis
     force = [max(end_reaction(system), 0.05 * bending_force_scale(scene))]
-    bcs = _copy_gauge(scene, positions=system.state.x)
+    bcs = gauge(scene, positions=system.state.x)
     bcs.rest_length_scale((shrink, shrink))
     bcs.force(0, last, lambda t: force[0] * axis)
     pull = RodSystem(scene.model, system.state, bcs)

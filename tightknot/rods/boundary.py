@@ -63,8 +63,15 @@ class BoundaryConditions:
     Build, then pass to a solver. Indices are per rod (negative counts from the rod's end).
     """
 
-    def __init__(self, model: Model) -> None:
+    def __init__(self, model: Model, positions: np.ndarray | None = None) -> None:
+        """``positions`` [m], (vertex_count, 3): where clamped and pinned vertices start
+        (their prescribed motion is added to these); default the model's initial ones."""
         self.model = model
+        pos = model.vertex_initial_position if positions is None else positions
+        pos = np.array(pos, dtype=np.float64)
+        if pos.shape != (model.vertex_count, 3) or not np.isfinite(pos).all():
+            raise ValueError(f"positions must be finite with shape {(model.vertex_count, 3)}")
+        self.positions = pos
         self._clamps: list[_Clamp] = []
         self._pins: list[_Pin] = []
         self._fixed_twist: list[int] = []
@@ -110,7 +117,7 @@ class BoundaryConditions:
             last = info.vertex_start + info.vertex_count - 1
             vs = (last, last - 1)
             edge = info.edge_start + info.edge_count - 1
-        x0 = self.model.vertex_initial_position[list(vs)].copy()
+        x0 = self.positions[list(vs)].copy()
         self._clamps.append(_Clamp(vs, edge, _as_path_vec(translation, "translation"),
                                    _as_path_vec(rotation, "rotation"), x0, None))
         return self
@@ -120,7 +127,7 @@ class BoundaryConditions:
     ) -> BoundaryConditions:
         """Fix a vertex's position (free to rotate), optionally moved along the path [m]."""
         v = self._vertex(rod, vertex)
-        x0 = self.model.vertex_initial_position[v].copy()
+        x0 = self.positions[v].copy()
         self._pins.append(_Pin(v, _as_path_vec(translation, "translation"), x0))
         return self
 
