@@ -5,12 +5,12 @@ BIN := $(VENV)/bin
 # Kernel cache shared by every run and test of this checkout (compile once, reuse).
 export WARP_CACHE_PATH ?= $(CURDIR)/.warp_cache
 
-.PHONY: demo test test-slow venv lint clean
+.PHONY: demo test test-slow test-extremes venv lint clean
 
 $(BIN)/tightknot: pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[fem,test]"
+	$(BIN)/python -m pip install --quiet -e ".[fem,test,distributed]"
 	touch $(BIN)/tightknot
 
 venv: $(BIN)/tightknot
@@ -24,6 +24,10 @@ test: venv
 
 test-slow: venv
 	$(BIN)/python -m pytest -q -m slow
+
+# The whole numerical-stability stress suite (CI runs only its fast subset).
+test-extremes: venv
+	$(BIN)/python -m pytest -q tests/extremes --run-extremes
 
 lint: venv
 	$(BIN)/ruff check .
