@@ -75,37 +75,6 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-# -- bench -----------------------------------------------------------------------------------
-_BENCH_EXAMPLES = """examples:
-  tightknot bench der --json der.json
-  tightknot bench der --sizes 100 1000 --no-startup
-"""
-
-
-def _cmd_bench(args: argparse.Namespace) -> int:
-    from tightknot.atomic import write_json_atomic
-    from tightknot.benchmarks import der
-    from tightknot.warp_setup import resolve_device
-
-    out = _writable_file(args.json)
-    device = resolve_device(args.device)
-    if args.which != "der":
-        raise ValueError(f"unknown benchmark {args.which!r}; valid: der")
-    sizes = tuple(args.sizes) if args.sizes else der.DEFAULT_SIZES
-    if any(n < 3 for n in sizes):
-        raise ValueError("--sizes must be >= 3 vertices each")
-    result = der.run(sizes, startup=not args.no_startup, device=device)
-    for r in result["rows"]:
-        print(f"{r['vertices']:>8d} vertices: iteration {r['newton_iteration_s'] * 1e3:9.3f} ms"
-              f"  (assembly {r['assembly_s'] * 1e3:8.3f} ms, solve {r['solve_s'] * 1e3:8.3f} ms)")
-    for key in ("ratio_1e5_over_1e3", "startup_cold_cache_s", "startup_warm_cache_s"):
-        if key in result:
-            print(f"{key}: {result[key]:.3f}")
-    if out is not None:
-        write_json_atomic(out, result)
-    return EXIT_OK
-
-
 # -- tie -------------------------------------------------------------------------------------
 _TIE_EXAMPLES = """examples:
   tightknot tie closed --json closed.json --figures figs --rrd closed.rrd
@@ -208,17 +177,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_verify)
 
-    p = sub.add_parser("bench", help="benchmarks (der: Newton-iteration cost vs size)",
-                       description="Benchmarks; results print and go to --json FILE.",
-                       epilog=_BENCH_EXAMPLES,
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("which", choices=["der"], help="which benchmark")
-    p.add_argument("--json", metavar="FILE", help="write the result as JSON")
-    p.add_argument("--sizes", type=int, nargs="+", help="vertex counts (default 1e2..1e5)")
-    p.add_argument("--no-startup", action="store_true", help="skip the start-up timing")
-    p.add_argument("--device", default=None, help="Warp device (default cpu)")
-    p.set_defaults(handler=_cmd_bench)
-
     p = sub.add_parser("tie", help="tie and tighten the study's trefoils, measure them",
                        description="Tie a closed trefoil (rest length L0 = l0/d0 D0) or an "
                        "open trefoil (tightened, then pulled by a force or to an end-to-end "
@@ -252,11 +210,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_demo)
 
+    from tightknot.benchmarks.commands import register as register_bench
     from tightknot.fem.commands import register as register_fem
     from tightknot.knots.commands import register as register_knots
 
     register_knots(sub)
     register_fem(sub)
+    register_bench(sub)
     return parser
 
 

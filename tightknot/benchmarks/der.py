@@ -102,3 +102,48 @@ def run(sizes: tuple[int, ...] = DEFAULT_SIZES, startup: bool = True,
         "startup_warm_cache_max_s": 1.0,
     }
     return result
+
+
+# -- command line (``tightknot bench der``) --------------------------------------------------
+_EXAMPLES = """examples:
+  tightknot bench der --json der.json
+  tightknot bench der --sizes 100 1000 --no-startup
+"""
+
+
+def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers type)
+    """Add ``tightknot bench der``."""
+    import argparse
+
+    p = subparsers.add_parser(
+        "der", help="Newton-iteration cost of the DER core versus size (1e2..1e5)",
+        description="Cost of one Newton iteration (assembly + sparse solve) of a clamped "
+        "helix with N vertices, and the Warp start-up with a cold and a warm kernel cache.",
+        epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--json", metavar="FILE", help="write the result as JSON")
+    p.add_argument("--sizes", type=int, nargs="+", help="vertex counts (default 1e2..1e5)")
+    p.add_argument("--no-startup", action="store_true", help="skip the start-up timing")
+    p.add_argument("--device", default=None, help="Warp device (default cpu)")
+    p.set_defaults(handler=_command)
+
+
+def _command(args) -> int:  # noqa: ANN001
+    from tightknot.atomic import write_json_atomic
+    from tightknot.cli import _writable_file
+    from tightknot.warp_setup import resolve_device
+
+    out = _writable_file(args.json)
+    device = resolve_device(args.device)
+    sizes = tuple(args.sizes) if args.sizes else DEFAULT_SIZES
+    if any(n < 3 for n in sizes):
+        raise ValueError("--sizes must be >= 3 vertices each")
+    result = run(sizes, startup=not args.no_startup, device=device)
+    for r in result["rows"]:
+        print(f"{r['vertices']:>8d} vertices: iteration {r['newton_iteration_s'] * 1e3:9.3f} ms"
+              f"  (assembly {r['assembly_s'] * 1e3:8.3f} ms, solve {r['solve_s'] * 1e3:8.3f} ms)")
+    for key in ("ratio_1e5_over_1e3", "startup_cold_cache_s", "startup_warm_cache_s"):
+        if key in result:
+            print(f"{key}: {result[key]:.3f}")
+    if out is not None:
+        write_json_atomic(out, result)
+    return 0
