@@ -77,63 +77,177 @@ def _cmd_verify(args: argparse.Namespace) -> int:
 
 # -- tie -------------------------------------------------------------------------------------
 _TIE_EXAMPLES = """examples:
-  tightknot tie closed --json closed.json --figures figs --rrd closed.rrd
-  tightknot tie closed --l0-over-d0 18 --nodes 200
-  tightknot tie open --length 0.185 --target-lambda 15.0 --json open.json
-  tightknot tie open --length 0.125 --target-lambda 10.1 --figures figs
-  tightknot tie open --length 0.185 --force 5
+  tightknot tie closed                                   # writes runs/closed_trefoil-<time>/
+  tightknot tie closed --nodes 100 --out runs/closed100 --color-by area_ratio
+  tightknot tie open --length 0.185 --target-lambda 15.0 --out runs/loose
+  tightknot tie open --length 0.125 --target-lambda 10.1 --out runs/tight
+  tightknot tie open --length 0.185 --force 5 --json open.json
+  tightknot tie --config runs/tight/config.json --out runs/tight-again   # rerun a run
+  tightknot tie --config runs/tight/config.json --nodes 400              # ... with a change
+
+run folder (--out DIR, default runs/<scene>-<UTC time>):
+  config.json     the exact parameters; tightknot tie --config FILE reruns them (JSON or TOML)
+  summary.json    converged, failure, knot type, measurements, final centerline_m [m]
+  centerline.csv  final centerline x,y,z [m]; its header says how to tightknot analyze it
+  figures/        the study's figures and the tube coloured by curvature (tube_kappa_D0.png)
+  run.rrd         rerun log of every load step: tightknot view DIR/run.rrd
+--json/--rrd/--figures send one output elsewhere. Config keys: {keys}.
+Exit codes: 0 converged, 1 the physics failed (summary and .rrd are still written), 2 bad input.
 """
+
+# Tie flags that set a config key (flag dest = key); None = not given on the command line.
+_TIE_KEYS = ("l0_over_d0", "length", "force", "end_distance", "target_lambda", "nodes",
+             "diameter", "youngs_modulus", "poisson", "density", "tighten_steps", "pull_steps",
+             "residual_tol", "relax_iterations", "color_by", "device")
+_TIE_LOADS = ("force", "end_distance", "target_lambda")
+
+
+def tie_config(args: argparse.Namespace):
+    """The run's :class:`tightknot.config.TieConfig`: ``--config FILE`` (if given), then the
+    knot and every flag given on the command line on top (a load flag replaces the file's
+    load)."""
+    from tightknot.config import config_from_dict, load_config
+
+    data: dict = load_config(args.config).to_dict() if args.config is not None else {}
+    if args.knot is not None:
+        if data.get("knot") not in (None, args.knot):
+            # Another knot: the file's knot-specific values do not carry over.
+            data = {k: v for k, v in data.items()
+                    if k not in ("nodes", "length", "l0_over_d0") + _TIE_LOADS}
+        data["knot"] = args.knot
+    if "knot" not in data:
+        raise ValueError("give the knot (closed or open) or --config FILE")
+    flags = {k: getattr(args, k) for k in _TIE_KEYS if getattr(args, k) is not None}
+    if any(k in flags for k in _TIE_LOADS):
+        data = {k: v for k, v in data.items() if k not in _TIE_LOADS}
+    data.update(flags)
+    return config_from_dict(data)
 
 
 def _cmd_tie(args: argparse.Namespace) -> int:
     from tightknot.atomic import write_json_atomic
+    from tightknot.knots.ideal import load_ideal_trefoil
     from tightknot.knots.run import draw_figures, run_knot
     from tightknot.knots.scenes import closed_trefoil, open_trefoil
+    from tightknot.progress import Progress, phase_progress
     from tightknot.rods.material import Material
+    from tightknot.run_folder import plan_outputs, write_centerline
     from tightknot.viz.rerun_log import make_logger
     from tightknot.warp_setup import resolve_device
 
-    out = _writable_file(args.json)
-    rrd = _writable_file(args.rrd)
-    if args.figures is not None and not Path(args.figures).parent.exists():
-        raise ValueError(f"--figures parent folder does not exist: {Path(args.figures).parent}")
-    device = resolve_device(args.device)
-    material = Material(args.youngs_modulus, args.poisson, 1160.0)
-    if args.knot == "closed":
-        if any(v is not None for v in (args.length, args.force, args.end_distance,
-                                       args.target_lambda)):
-            raise ValueError("--length/--force/--end-distance/--target-lambda are for open knots")
-        scene = closed_trefoil(args.l0_over_d0, args.diameter, args.nodes or 200, material,
-                               device=device)
-        options: dict = {}
+    cfg = tie_config(args)
+    # Every output path is checked before any work (issue 6: fail early, not after minutes).
+    outs = plan_outputs(cfg.scene_name, args.out, args.json, args.rrd, args.figures)
+    device = resolve_device(cfg.device)
+    material = Material(cfg.youngs_modulus, cfg.poisson, cfg.density)
+    if cfg.knot == "closed":
+        scene = closed_trefoil(cfg.l0_over_d0, cfg.diameter, cfg.nodes, material, device=device)
     else:
-        given = [v is not None for v in (args.force, args.end_distance, args.target_lambda)]
-        if sum(given) != 1:
-            raise ValueError("give one of --force F [N], --end-distance X [m] or "
-                             "--target-lambda LAMBDA")
-        if args.target_lambda is not None and not (0 < args.target_lambda < 1e3):
-            raise ValueError(f"--target-lambda must be in (0, 1000), got {args.target_lambda}")
-        scene = open_trefoil(args.length if args.length is not None else 0.185, args.diameter,
-                             args.nodes or 300, material, device=device)
-        options = ({"target_lambda": args.target_lambda} if args.target_lambda is not None
-                   else {"pull_force": args.force, "end_distance": args.end_distance})
-    with make_logger(rrd) as log:
-        run = run_knot(scene, log if rrd is not None else None, args.knot, [0],
-                       tighten_steps=40, pull_steps=10, **options)
+        scene = open_trefoil(cfg.length, cfg.diameter, cfg.nodes, material, device=device)
+    outs.create()
+    # The parameters first: a run killed half-way can still be repeated.
+    write_json_atomic(outs.config, cfg.to_dict())
+    bar = Progress(scene.name, enabled=False if args.quiet else None)
+    with make_logger(outs.rrd) as log:
+        if scene.closed:
+            ideal = load_ideal_trefoil(scene.diameter)
+            # Beside the rod (6 D0 below), so that both stay visible.
+            log.log_reference("ideal_trefoil",
+                              ideal - ideal.mean(axis=0) + [0.0, 0.0, -6 * scene.diameter],
+                              scene.diameter / 2)
+        with bar:
+            run = run_knot(scene, log, cfg.knot, [0], color_by=cfg.color_by,
+                           progress=phase_progress(bar, scene.closed), **cfg.tie_options())
     summary = run.summary
-    if args.figures is not None:
-        draw_figures([run], Path(args.figures))
-    if out is not None:
-        write_json_atomic(out, summary)
+    x = run.result.system.state.x
+    write_json_atomic(outs.summary, summary)
+    write_centerline(outs.centerline, x, scene.name, scene.diameter, scene.rest_length,
+                     scene.closed)
+    figures = draw_figures([run], outs.figures, tube=cfg.color_by)
     if not args.quiet:
-        keys = ("knot_type", "converged", "stretch", "L_over_D", "lambda_oc", "pull_force_N",
-                "min_gap_over_D0", "min_area_ratio", "max_contact_width_fraction",
-                "max_pressure_over_E", "newton_iterations", "wall_time_s")
+        keys = ("knot_type", "converged", "load_steps", "stretch", "L_over_D", "lambda_oc",
+                "pull_force_N", "min_gap_over_D0", "min_area_ratio",
+                "max_contact_width_fraction", "max_pressure_over_E", "newton_iterations",
+                "wall_time_s")
         for k in keys:
             if k in summary:
                 print(f"  {k:28s} {summary[k]}")
+        print(f"wrote {outs.folder}/ ({outs.config.name}, {outs.centerline.name})")
+        for path in (outs.summary, outs.rrd, *figures):
+            if outs.folder not in path.parents:
+                print(f"wrote {path}")
+        print(f"look at it: tightknot view {outs.rrd}")
     if not run.result.converged:
-        print(f"tightknot tie: failed: {run.result.failure}", file=sys.stderr)
+        print(f"tightknot tie: failed: {run.result.failure} (after {summary['load_steps']} "
+              f"converged load steps; the final state is the last step of {outs.rrd})",
+              file=sys.stderr)
+        return EXIT_PHYSICS
+    return EXIT_OK
+
+
+# -- view ------------------------------------------------------------------------------------
+_VIEW_EXAMPLES = """examples:
+  tightknot view runs/demo/demo.rrd
+  tightknot view runs/closed_trefoil-20261123-160000/run.rrd
+  tightknot view run.rrd --print-only      # just print the command that opens it
+
+The viewer is the 'rerun' executable of rerun-sdk (a dependency of tightknot). Without a
+display (no DISPLAY or WAYLAND_DISPLAY on Linux) the command to run elsewhere is printed;
+'rerun --web-viewer FILE' serves the viewer to a browser instead.
+"""
+
+#: The first bytes of a rerun recording file (rerun's RRF2 encoding).
+RRD_MAGIC = b"RRF2"
+
+
+def find_viewer() -> str | None:
+    """Path of the ``rerun`` viewer executable: the one installed beside this Python
+    (rerun-sdk's console script), else the first on PATH; None when there is none."""
+    import os
+    import shutil
+
+    beside = Path(sys.executable).with_name("rerun")
+    if beside.is_file() and os.access(beside, os.X_OK):
+        return str(beside)
+    return shutil.which("rerun")
+
+
+def _has_display() -> bool:
+    import os
+
+    if sys.platform in ("darwin", "win32"):
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    import shlex
+    import subprocess
+
+    path = Path(args.file)
+    if not path.is_file():
+        raise ValueError(f"{path}: no such file" if not path.exists() else
+                         f"{path}: not a file")
+    try:
+        with path.open("rb") as handle:
+            magic = handle.read(len(RRD_MAGIC))
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
+    if magic != RRD_MAGIC:
+        raise ValueError(f"{path}: not a rerun recording (.rrd files start with "
+                         f"{RRD_MAGIC.decode()})")
+    viewer = find_viewer()
+    command = f"{shlex.quote(viewer or 'rerun')} {shlex.quote(str(path))}"
+    if args.print_only or viewer is None or not _has_display():
+        if not args.print_only:
+            why = ("no 'rerun' executable found (pip install 'rerun-sdk>=0.41,<0.42')"
+                   if viewer is None else "no display here")
+            print(f"tightknot view: {why}; open the recording with:")
+        print(command)
+        return EXIT_OK
+    rc = subprocess.call([viewer, str(path)])
+    if rc != 0:
+        print(f"tightknot view: the viewer exited with code {rc}: {command}", file=sys.stderr)
         return EXIT_PHYSICS
     return EXIT_OK
 
@@ -177,27 +291,47 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_verify)
 
+    from tightknot.config import COLOR_ALIASES, COLOR_FIELDS, config_keys
+
     p = sub.add_parser("tie", help="tie and tighten the study's trefoils, measure them",
                        description="Tie a closed trefoil (rest length L0 = l0/d0 D0) or an "
-                       "open trefoil (tightened, then pulled by a force or to an end-to-end "
-                       "distance) in an elastomer rod, and measure it as the study did.",
-                       epilog=_TIE_EXAMPLES,
+                       "open trefoil (tightened, then pulled by a force, to an end-to-end "
+                       "distance or to a target Lambda_OC) in an elastomer rod, measure it as "
+                       "the study did, and write everything into one run folder.",
+                       epilog=_TIE_EXAMPLES.format(keys=", ".join(config_keys())),
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("knot", choices=["closed", "open"], help="closed or open trefoil")
-    p.add_argument("--l0-over-d0", type=float, default=16.37, help="closed: L0/D0 (16.37)")
-    p.add_argument("--length", type=float, default=None, help="open: rest length L0 [m]")
+    p.add_argument("knot", nargs="?", choices=["closed", "open"],
+                   help="closed or open trefoil (optional with --config)")
+    p.add_argument("--config", metavar="FILE",
+                   help="parameters from a run folder's config.json (or TOML); flags override")
+    p.add_argument("--l0-over-d0", type=float, default=None, help="closed: L0/D0 (16.37)")
+    p.add_argument("--length", type=float, default=None, help="open: rest length L0 [m] (0.185)")
     p.add_argument("--force", type=float, default=None, help="open: pulling force [N]")
     p.add_argument("--end-distance", type=float, default=None,
                    help="open: final end-to-end distance [m]")
     p.add_argument("--target-lambda", type=float, default=None,
                    help="open: pull until Lambda_OC reaches this (within 0.1)")
     p.add_argument("--nodes", type=int, default=None, help="vertices (200 closed, 300 open)")
-    p.add_argument("--diameter", type=float, default=8.5e-3, help="rest diameter D0 [m]")
-    p.add_argument("--youngs-modulus", type=float, default=1.25e6, help="E [Pa]")
-    p.add_argument("--poisson", type=float, default=0.5, help="Poisson ratio in (-1, 0.5]")
-    p.add_argument("--json", metavar="FILE", help="write the summary as JSON")
-    p.add_argument("--figures", metavar="DIR", help="write the study's figures here")
-    p.add_argument("--rrd", metavar="FILE", help="write a rerun log of every load step")
+    p.add_argument("--diameter", type=float, default=None, help="rest diameter D0 [m] (8.5e-3)")
+    p.add_argument("--youngs-modulus", type=float, default=None, help="E [Pa] (1.25e6)")
+    p.add_argument("--poisson", type=float, default=None, help="Poisson ratio in (-1, 0.5] (0.5)")
+    p.add_argument("--density", type=float, default=None, help="density [kg/m^3] (1160)")
+    p.add_argument("--tighten-steps", type=int, default=None,
+                   help="initial load steps of the tightening (40)")
+    p.add_argument("--pull-steps", type=int, default=None,
+                   help="initial load steps of the pull (10)")
+    p.add_argument("--residual-tol", type=float, default=None,
+                   help="Newton tolerance on the scaled residual (1e-6)")
+    p.add_argument("--relax-iterations", type=int, default=None,
+                   help="Newton budget of the start curve's relaxation (2000)")
+    p.add_argument("--color-by", default=None, metavar="FIELD",
+                   choices=list(COLOR_FIELDS) + list(COLOR_ALIASES),
+                   help=f"colour of the rod tube in the .rrd: {', '.join(COLOR_FIELDS)} "
+                   "(kappa_D0; contact_width = contact_width_fraction)")
+    p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>)")
+    p.add_argument("--json", metavar="FILE", help="write the summary here instead")
+    p.add_argument("--figures", metavar="DIR", help="write the figures here instead")
+    p.add_argument("--rrd", metavar="FILE", help="write the rerun log here instead")
     p.add_argument("--device", default=None, help="Warp device (default cpu)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_tie)
@@ -209,6 +343,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="runs/demo", help="output folder (created)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_demo)
+
+    p = sub.add_parser("view", help="open a .rrd in the rerun viewer (or print how)",
+                       description="Open a rerun recording written by tie or demo in the rerun "
+                       "viewer; without a viewer or a display, print the command that opens it.",
+                       epilog=_VIEW_EXAMPLES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("file", metavar="FILE.rrd", help="the recording")
+    p.add_argument("--print-only", action="store_true",
+                   help="print the viewer command instead of running it")
+    p.set_defaults(handler=_cmd_view)
 
     from tightknot.benchmarks.commands import register as register_bench
     from tightknot.fem.commands import register as register_fem

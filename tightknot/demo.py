@@ -17,6 +17,7 @@ from tightknot.atomic import write_json_atomic
 from tightknot.knots.ideal import load_ideal_trefoil
 from tightknot.knots.run import draw_figures, run_knot
 from tightknot.knots.scenes import closed_trefoil, open_trefoil
+from tightknot.progress import Progress, phase_progress
 from tightknot.viz.rerun_log import make_logger
 
 #: The study's open knots: (name, rest length [m], target Lambda_OC, vertices).
@@ -35,10 +36,17 @@ def run_demo(out: Path, quiet: bool = False) -> dict:
         log.log_reference("ideal_trefoil",
                           ideal - ideal.mean(axis=0) + [0.0, 0.0, -6 * closed.diameter],
                           closed.diameter / 2)
-        runs = {"closed_trefoil": run_knot(closed, log, "closed", counter, tighten_steps=40)}
+        with Progress("closed_trefoil", enabled=False if quiet else None) as bar:
+            runs = {"closed_trefoil": run_knot(closed, log, "closed", counter,
+                                               progress=phase_progress(bar, True),
+                                               tighten_steps=40)}
         for name, length, target, nodes in OPEN_KNOTS:
             scene = open_trefoil(rest_length=length, nodes=nodes)
-            runs[name] = run_knot(scene, log, name, counter, target_lambda=target)
+            # A pull to a target Lambda_OC reports its tightening; the force search after
+            # it shows as the bar standing at the end of the tightening.
+            with Progress(name, enabled=False if quiet else None) as bar:
+                runs[name] = run_knot(scene, log, name, counter, target_lambda=target,
+                                      progress=phase_progress(bar, False))
     draw_figures(list(runs.values()), out / "figures")
     summary = {
         "knots": {name: {k: v for k, v in r.summary.items() if not isinstance(v, list)}

@@ -6,6 +6,7 @@ same keys (the knots issue's JSON summary).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,7 +18,7 @@ from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal import load_ideal_trefoil
 from tightknot.knots.measure import analyze_centerline
 from tightknot.knots.scenes import KnotScene, vertex_radii
-from tightknot.knots.tie import TieResult, tie, tie_to_lambda
+from tightknot.knots.tie import TieResult, lambda_oc, tie, tie_to_lambda
 from tightknot.rods.contact import ContactReport, contact_report
 from tightknot.solvers.system import RodSystem
 
@@ -37,29 +38,92 @@ class KnotRun:
     summary: dict
 
 
-def logging_hook(log: Any, scene: KnotScene, name: str, counter: list[int]):
-    """A tie hook that logs each converged load step under ``name/`` on one timeline."""
-    d0 = scene.diameter
+#: Fields the rod tube can be coloured by (the names of rerun_log.ROD_FIELDS).
+COLOR_FIELDS = ("kappa_D0", "area_ratio", "stretch", "contact_width_fraction")
+
+#: progress(phase, t, step): called after each converged load step with the phase name,
+#: its load parameter t in [0, 1] and the step's index on the load_step timeline.
+ProgressCallback = Callable[[str, float, int], None]
+
+
+def rod_field(name: str, scene: KnotScene, x: np.ndarray, rest: np.ndarray,
+              rep: ContactReport) -> tuple[np.ndarray, str]:
+    """Values of colouring field ``name`` at centerline ``x`` [m] and where they live.
+
+    kappa_D0: Bergou curvature times D0 per vertex; area_ratio: A/A0 per vertex and
+    contact_width_fraction: L_c per vertex (contact report); stretch: |e|/|e0| per edge
+    (``rest``: the edge rest lengths of the current load [m]).
+    """
+    if name == "kappa_D0":
+        return bergou_curvature(x, scene.closed) * scene.diameter, "vertex"
+    if name == "area_ratio":
+        return rep.area_ratio, "vertex"
+    if name == "contact_width_fraction":
+        return rep.contact_width_fraction, "vertex"
+    if name == "stretch":
+        ev = scene.model.edge_vertex
+        return np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1) / rest, "edge"
+    raise ValueError(f"unknown colouring field {name!r}; valid: {', '.join(COLOR_FIELDS)}")
+
+
+def check_color_field(name: str) -> str:
+    """``name`` if it is a colouring field, else ValueError naming the valid ones."""
+    if name not in COLOR_FIELDS:
+        raise ValueError(f"--color-by {name!r}: unknown field; valid: {', '.join(COLOR_FIELDS)}")
+    return name
+
+
+def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
+              color_by: str = "kappa_D0") -> None:
+    """Log the rod (tube coloured by ``color_by``, deformed radii) and its contact pairs
+    (coloured by peak p/E) at the logger's current step; open knots also get their
+    end-to-end distance [m] and Lambda_OC [1] (when in contact)."""
+    x = system.state.x
+    r_e, r_v = vertex_radii(scene, x, system.rest)
+    rep = contact_report(scene.contact, x)
+    values, at = rod_field(color_by, scene, x, system.rest, rep)
+    log.log_rod(f"{name}/rod", x, scene.closed, r_e, values, color_by, field_at=at,
+                radii_at="edge")
+    ia = rep.pairs[:, 0].astype(int)
+    ib = rep.pairs[:, 1].astype(int)
+    log.log_contacts(f"{name}/contacts", x[ia], x[ib], rep.peak_pressure_over_E[ia])
+    if not scene.closed:
+        scalars = {f"{name}/end_to_end": float(np.linalg.norm(x[-1] - x[0]))}
+        lam = lambda_oc(x, scene.diameter, r_v, tol=CONTACT_TOL)
+        if np.isfinite(lam):
+            scalars[f"{name}/lambda_oc"] = lam
+        log.log_scalars(scalars)
+
+
+def logging_hook(log: Any, scene: KnotScene, name: str, counter: list[int],
+                 color_by: str = "kappa_D0", progress: ProgressCallback | None = None,
+                 logged: dict | None = None):
+    """A tie hook that logs each converged load step under ``name/`` on one timeline.
+
+    ``log`` may be None (no logging: only ``progress`` is called). ``logged`` (optional)
+    receives the last logged centerline under ``"x"``, so that the caller can tell whether
+    the final state still needs logging.
+    """
+    check_color_field(color_by)
 
     def hook(phase: str, system: RodSystem, rec: Any) -> None:
-        x = system.state.x
-        r_e, _ = vertex_radii(scene, x, system.rest)
-        kappa = bergou_curvature(x, scene.closed) * d0
-        log.set_step(counter[0], rec.t)
+        step = counter[0]
         counter[0] += 1
-        log.log_rod(f"{name}/rod", x, scene.closed, r_e, kappa, "kappa_D0")
-        rep = contact_report(scene.contact, x)
-        ia = rep.pairs[:, 0].astype(int)
-        ib = rep.pairs[:, 1].astype(int)
-        log.log_contacts(f"{name}/contacts", x[ia], x[ib], rep.peak_pressure_over_E[ia])
-        sp = system.last_split
-        log.log_scalars({
-            f"{name}/energy/stretch": sp.stretch, f"{name}/energy/bend": sp.bend,
-            f"{name}/energy/twist": sp.twist,
-            f"{name}/energy/contact": float(sum(sp.extra.values())),
-            f"{name}/newton_residual": float(rec.newton.residual),
-            f"{name}/newton_iterations": float(rec.newton.iterations),
-        })
+        if log is not None:
+            log.set_step(step, rec.t)
+            log_state(log, scene, name, system, color_by)
+            sp = system.last_split
+            log.log_scalars({
+                f"{name}/energy/stretch": sp.stretch, f"{name}/energy/bend": sp.bend,
+                f"{name}/energy/twist": sp.twist,
+                f"{name}/energy/contact": float(sum(sp.extra.values())),
+                f"{name}/newton_residual": float(rec.newton.residual),
+                f"{name}/newton_iterations": float(rec.newton.iterations),
+            })
+            if logged is not None:
+                logged["x"] = system.state.x.copy()
+        if progress is not None:
+            progress(phase, rec.t, step)
     return hook
 
 
@@ -106,17 +170,36 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
 
 
 def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
-             counter: list[int] | None = None, **tie_options: Any) -> KnotRun:
-    """Tie ``scene`` (options of :func:`tightknot.knots.tie.tie`), logging to ``log``."""
-    hook = None
-    if log is not None:
-        hook = logging_hook(log, scene, name or scene.name, counter if counter else [0])
+             counter: list[int] | None = None, *, color_by: str = "kappa_D0",
+             progress: ProgressCallback | None = None, **tie_options: Any) -> KnotRun:
+    """Tie ``scene`` (options of :func:`tightknot.knots.tie.tie`, or ``target_lambda`` for
+    :func:`tightknot.knots.tie.tie_to_lambda`), logging each load step to ``log`` with the
+    tube coloured by ``color_by`` and reporting it to ``progress``.
+
+    The final state is logged as one more step whenever it is not the last logged one (a
+    failed run, whose last attempt did not converge, or a pull to a target Lambda_OC, whose
+    force steps are not load steps), so the .rrd always ends on the state the summary
+    describes. ``summary["load_steps"]`` counts the converged load steps of the continuation
+    (the force steps of a pull to a target Lambda_OC are not load steps).
+    """
+    check_color_field(color_by)
+    name = name or scene.name
+    counter = counter if counter is not None else [0]
+    logged: dict = {}
+    # Always hooked: the hook numbers the steps on the timeline and reports progress.
+    hook = logging_hook(log, scene, name, counter, color_by, progress, logged)
     target = tie_options.pop("target_lambda", None)
     if target is not None:
-        res = tie_to_lambda(scene, target, hook=hook)
+        res = tie_to_lambda(scene, target, hook=hook, **tie_options)
     else:
         res = tie(scene, hook=hook, **tie_options)
+    # The solver's own record of converged load steps (each one was passed to the hook).
+    load_steps = sum(len(p.steps) for p in res.phases.values())
     x = res.system.state.x
+    if log is not None and not np.array_equal(logged.get("x"), x):
+        log.set_step(counter[0])
+        counter[0] += 1
+        log_state(log, scene, name, res.system, color_by)
     _, r_v = vertex_radii(scene, x, res.system.rest)
     # Contact as physics.md sec. 2 defines it for a rod model: distance at most the sum of
     # the deformed radii; the measurement's 1 % tolerance covers the vertex sampling of the
@@ -124,16 +207,42 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
                              radii=r_v, contact_tol=CONTACT_TOL)
     contact = contact_report(scene.contact, x)
-    return KnotRun(scene, res, rep, contact, summarise(scene, res, rep, contact))
+    summary = summarise(scene, res, rep, contact)
+    summary["load_steps"] = load_steps
+    return KnotRun(scene, res, rep, contact, summary)
 
 
-def draw_figures(runs: list[KnotRun], folder: Path) -> list[Path]:
-    """The study's figures of the runs into ``folder`` (created); returns the paths."""
+def draw_tube(run: KnotRun, path: Path, field: str = "kappa_D0") -> Path:
+    """The final rod of ``run`` as a 3D tube (deformed radii) coloured by ``field``."""
+    from tightknot.viz.tube_figure import render_tube
+
+    system = run.result.system
+    x = system.state.x
+    _, r_v = vertex_radii(run.scene, x, system.rest)
+    values, at = rod_field(check_color_field(field), run.scene, x, system.rest, run.contact)
+    s = run.summary
+    what = (f"L0/D0 = {run.scene.rest_length / run.scene.diameter:.2f}" if run.scene.closed
+            else f"L0 = {run.scene.rest_length * 1e3:.0f} mm, F = {s['pull_force_N']:.3g} N" + (
+                "" if s.get("lambda_oc") is None else f", Lambda_OC = {s['lambda_oc']:.2f}"))
+    title = f"{run.scene.name.replace('_', ' ')}: {what}, {s['knot_type']}"
+    return render_tube(path, x, r_v, run.scene.closed, values, field, title, field_at=at)
+
+
+def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> list[Path]:
+    """The study's figures of the runs into ``folder`` (created); returns the paths.
+
+    ``tube``: also draw each run's final rod as a tube coloured by this field
+    (``tube_<field>.png``; ``<i>_tube_<field>.png`` for several runs).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     folder.mkdir(parents=True, exist_ok=True)
     paths: list[Path] = []
+    if tube is not None:
+        for i, r in enumerate(runs):
+            name = f"tube_{tube}.png" if len(runs) == 1 else f"{i}_tube_{tube}.png"
+            paths.append(draw_tube(r, folder / name, tube))
     closed = [r for r in runs if r.scene.closed]
     opened = [r for r in runs if not r.scene.closed]
     if closed:
