@@ -162,19 +162,25 @@ def _check_edge_length(pts: np.ndarray, closed: bool, d0: float, nodes: int,
                          f"are {e.max() / d0:.3g} D0 long, above pi/4 D0), got {nodes!r}")
 
 
+def check_contact(contact: str, law: RadialComplianceLaw | None = None) -> str:
+    """The ``contact`` model level, checked against :data:`CONTACT_LEVELS` and ``law``."""
+    if contact not in CONTACT_LEVELS:
+        raise ValueError(f"contact must be one of {', '.join(CONTACT_LEVELS)}, got {contact!r}")
+    if contact == "off" and law is not None:
+        raise ValueError("a contact law was given with contact='off'")
+    if law is not None and law.rigid and contact == "compliant":
+        raise ValueError("contact='compliant' was given a rigid-tube law: use contact='rigid'")
+    return contact
+
+
 def contact_layer(model: Model, contact: str = "compliant",
                   law: RadialComplianceLaw | None = None) -> ContactLayer | None:
     """The contact layer of a model at the level ``contact`` (one of :data:`CONTACT_LEVELS`;
     what each neglects: module docstring). ``law``: the compliant law (default the shipped
     FEM calibration); "rigid" makes its rigid-tube version; "off" takes no law."""
-    if contact not in CONTACT_LEVELS:
-        raise ValueError(f"contact must be one of {', '.join(CONTACT_LEVELS)}, got {contact!r}")
+    check_contact(contact, law)
     if contact == "off":
-        if law is not None:
-            raise ValueError("a contact law was given with contact='off'")
         return None
-    if law is not None and law.rigid and contact == "compliant":
-        raise ValueError("contact='compliant' was given a rigid-tube law: use contact='rigid'")
     if contact == "rigid":
         base = law or RadialComplianceLaw.from_json()
         return ContactLayer(model, base if base.rigid else base.rigid_tube())
@@ -186,7 +192,6 @@ def _closed_knot(name: str, knot_type: str, curve: np.ndarray, ratio: float, d0:
                  twist: bool, contact: str, device: str, clearance: float) -> KnotScene:
     """A closed knot of rest length ``ratio`` D0 from a dense closed ``curve`` (any scale):
     resampled, scaled to L0, grown until the tube D0 fits (module docstring)."""
-    twist = check_twist(twist)
     pts = curves.resample_uniform(curve, int(nodes), closed=True)
     length = float(np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1).sum())
     pts *= ratio * d0 / length
@@ -233,6 +238,7 @@ def closed_trefoil(
     levels (module docstring)."""
     d0 = _check_common(diameter, nodes, 24)
     ratio = _check_ratio(l0_over_d0, "3_1")
+    twist, contact = check_twist(twist), check_contact(contact, law)
     return _closed_knot("closed_trefoil", "3_1", curves.trefoil(4000), ratio, d0, nodes,
                         material, law, twist, contact, device, clearance)
 
@@ -254,6 +260,7 @@ def closed_figure_eight(
     ``contact``: model levels (module docstring)."""
     d0 = _check_common(diameter, nodes, 32)
     ratio = _check_ratio(l0_over_d0, "4_1")
+    twist, contact = check_twist(twist), check_contact(contact, law)
     return _closed_knot("closed_figure_eight", "4_1", curves.figure_eight(4000), ratio, d0,
                         nodes, material, law, twist, contact, device, clearance)
 
@@ -268,7 +275,7 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
     rounding of the tail corners [knot-size units], applied to the whole curve, or only
     within ``corner_window`` units of the corners when given."""
     d0 = _check_common(diameter, nodes, 40)
-    twist = check_twist(twist)
+    twist, contact = check_twist(twist), check_contact(contact, law)
     l0 = check_positive("rest_length", rest_length, "m")
     if l0 < 10.0 * d0:
         raise ValueError(f"rest_length must be >= 10 D0 = {10 * d0:.4g} m for an open knot, "
