@@ -10,13 +10,17 @@ problem allows (no passing through, from the contact layer) and a backtracking A
 search on the total potential follows (Nocedal & Wright Alg. 3.1).
 
 Convergence: the scaled residual (forces over EI/L^2, moments over EI/L) is below
-``residual_tol``. The step size is reported and stagnation (tiny steps without a small
-residual) ends the loop as a failure. A failed solve returns a result saying so, never NaN.
+``residual_tol``. The step size is reported, and two kinds of stagnation end the loop as a
+failure instead of spending the iteration budget: tiny steps without a small residual
+("stagnated"), and no progress over a window of iterations, i.e. neither the best residual
+nor the energy improved by a measurable amount ("stalled": a solver cycling at a point it
+cannot pass). A failed solve returns a result saying so, never NaN.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -57,6 +61,14 @@ class NewtonOptions:
         shift_initial: first relative shift mu when the Hessian is not positive definite.
         shift_trust: first relative shift when steps overshoot (trust-region damping).
         shift_max: beyond this shift the solve gives up.
+        stall_iterations: window of the no-progress test (0 turns it off): the solve stops
+            as "stalled" when over this many iterations the best residual did not fall
+            below ``stall_factor`` times its value before the window and the energy fell
+            by less than ``stall_roundoffs`` times its round-off.
+        stall_factor: residual improvement that counts as progress [-].
+        stall_roundoffs: energy decrease that counts as progress, in units of the
+            problem's energy round-off (a thousand: well above noise, yet far below the
+            decrease of any iteration that moves the rod measurably).
     """
 
     residual_tol: float = 1e-8
@@ -67,15 +79,23 @@ class NewtonOptions:
     shift_initial: float = 1e-8
     shift_trust: float = 1e-3
     shift_max: float = 1e8
+    stall_iterations: int = 50
+    stall_factor: float = 0.5
+    stall_roundoffs: float = 1e3
 
     def __post_init__(self) -> None:
         for name in ("residual_tol", "step_tol", "armijo", "shift_initial", "shift_trust",
-                     "shift_max"):
+                     "shift_max", "stall_factor", "stall_roundoffs"):
             v = getattr(self, name)
-            if not (math.isfinite(v) and v > 0):
+            if not (isinstance(v, numbers.Real) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v!r}")
-        if self.max_iterations < 1:
-            raise ValueError(f"max_iterations must be >= 1, got {self.max_iterations}")
+        for name, low in (("max_iterations", 1), ("max_backtracks", 1),
+                          ("stall_iterations", 0)):
+            v = getattr(self, name)
+            if not (isinstance(v, numbers.Integral) and v >= low):
+                raise ValueError(f"{name} must be a whole number >= {low}, got {v!r}")
+        if self.stall_factor >= 1.0:
+            raise ValueError(f"stall_factor must be in (0, 1), got {self.stall_factor!r}")
 
 
 @dataclass
@@ -89,7 +109,7 @@ class NewtonResult:
         step: last scaled step [-].
         energy: final total potential [J].
         reason: why the loop stopped ("converged", "max_iterations", "stagnated",
-            "line_search_failed", "non_finite").
+            "stalled", "line_search_failed", "non_finite").
         history: scaled residual after each iteration.
     """
 
@@ -118,6 +138,9 @@ def newton_solve(
     if res <= opt.residual_tol:
         problem.accept(u)
         return NewtonResult(True, 0, res, 0.0, energy, "converged", history)
+    # Progress record of the stall test: best residual and energy after each iteration.
+    best = [res]
+    energies = [energy]
     for it in range(1, opt.max_iterations + 1):
         accepted = False
         diag = np.abs(h.diagonal())
@@ -180,7 +203,22 @@ def newton_solve(
             return NewtonResult(True, it, res, step, energy, "converged", history)
         if step <= opt.step_tol:
             return NewtonResult(False, it, res, step, energy, "stagnated", history)
+        best.append(min(best[-1], res))
+        energies.append(energy)
+        if _stalled(best, energies, opt, problem.energy_roundoff()):
+            return NewtonResult(False, it, res, step, energy, "stalled", history)
     return NewtonResult(False, opt.max_iterations, res, step, energy, "max_iterations", history)
+
+
+def _stalled(best: list[float], energies: list[float], opt: NewtonOptions,
+             roundoff: float) -> bool:
+    """No progress over the last ``stall_iterations`` iterations (see NewtonOptions)."""
+    w = opt.stall_iterations
+    if w == 0 or len(best) <= w:
+        return False
+    if best[-1] < opt.stall_factor * best[-1 - w]:
+        return False
+    return energies[-1 - w] - energies[-1] <= opt.stall_roundoffs * roundoff
 
 
 def _shifted_direction(

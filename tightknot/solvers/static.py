@@ -3,14 +3,23 @@
 The load parameter t goes from 0 to 1 in steps; each step is a Newton solve started from
 the previous equilibrium. A step that fails is halved (the state is restored), an easy one
 lets the next grow, so the path passes where a fixed step would not.
+
+Every failure says where it happened: the load step (its number, counting the converged
+steps, and its interval in t), the Newton reason and residual; the iterate at which the
+failed step stopped is kept (``StaticResult.failed_state``) so that it can be looked at,
+while the system is left at the last equilibrium. A total Newton-iteration budget
+(``max_newton_iterations``) bounds the work of a path that keeps halving and regrowing.
 """
 
 from __future__ import annotations
 
+import math
+import numbers
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from tightknot.rods.state import State
 from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton_solve
 from tightknot.solvers.system import RodSystem
 
@@ -29,6 +38,8 @@ class ContinuationOptions:
             proximal steps (:func:`tightknot.solvers.dynamic.proximal_relax`) starting with
             this time step [s], before the step is halved: the way through a limit point.
         proximal_steps: their budget.
+        max_newton_iterations: total Newton iterations of the whole path, failed attempts
+            included, after which it stops as failed (None: no limit).
     """
 
     steps: int = 1
@@ -38,12 +49,27 @@ class ContinuationOptions:
     newton: NewtonOptions = field(default_factory=NewtonOptions)
     proximal_dt: float | None = None
     proximal_steps: int = 100
+    max_newton_iterations: int | None = None
 
     def __post_init__(self) -> None:
-        if self.steps < 1:
-            raise ValueError(f"steps must be >= 1, got {self.steps}")
+        if not (isinstance(self.steps, numbers.Integral) and self.steps >= 1):
+            raise ValueError(f"steps must be a whole number >= 1, got {self.steps!r}")
+        for name in ("min_step", "max_step", "grow_below", "proximal_steps"):
+            v = getattr(self, name)
+            if not (isinstance(v, numbers.Real) and math.isfinite(v)):
+                raise ValueError(f"{name} must be a finite number, got {v!r}")
         if not (0 < self.min_step <= self.max_step <= 1):
-            raise ValueError("need 0 < min_step <= max_step <= 1")
+            raise ValueError(f"need 0 < min_step <= max_step <= 1, got min_step="
+                             f"{self.min_step!r}, max_step={self.max_step!r}")
+        if self.proximal_dt is not None and not (
+                isinstance(self.proximal_dt, numbers.Real) and math.isfinite(self.proximal_dt)
+                and self.proximal_dt > 0):
+            raise ValueError(f"proximal_dt must be None or finite and > 0 s, got "
+                             f"{self.proximal_dt!r}")
+        m = self.max_newton_iterations
+        if m is not None and not (isinstance(m, numbers.Integral) and m >= 1):
+            raise ValueError(f"max_newton_iterations must be None or a whole number >= 1, "
+                             f"got {m!r}")
 
 
 @dataclass
@@ -63,8 +89,11 @@ class StaticResult:
         t: the load parameter reached.
         steps: the converged steps.
         newton_iterations: total Newton iterations, failed attempts included.
-        failure: why it stopped early ("" when converged).
+        failure: why it stopped early ("" when converged): the load step and its t.
         wall_time_s: wall-clock time [s].
+        failed_state: the state where the failing step's solve stopped (None when
+            converged, or when a callback refused a converged step: then it is the
+            system's state), for looking at what went wrong.
     """
 
     converged: bool
@@ -73,6 +102,7 @@ class StaticResult:
     newton_iterations: int
     failure: str
     wall_time_s: float
+    failed_state: State | None = None
 
 
 StepCallback = Callable[[RodSystem, StepRecord], str | None]
@@ -108,8 +138,10 @@ def solve_static(
         if res.converged:
             records.append(rec)
         return StaticResult(res.converged, 1.0, records, total_iters,
-                            "" if res.converged else f"Newton {res.reason} at t=1",
-                            time.perf_counter() - start)
+                            "" if res.converged else
+                            f"Newton {res.reason} (residual {res.residual:.3g}) at load step 1 "
+                            "(t=1)", time.perf_counter() - start,
+                            None if res.converged else system.state.copy())
     while t < 1.0 - 1e-14:
         t_next = min(1.0, t + dt)
         saved = system.state.copy()
@@ -130,16 +162,23 @@ def solve_static(
                 res = NewtonResult(True, res.iterations + prox.newton_iterations,
                                    system.residual_norm(g), 0.0, system.last_split.total,
                                    "converged_by_proximal_steps", res.history)
+        where = f"load step {len(records) + 1} (from t={t:.6g} to t={t_next:.6g})"
         if not res.converged:
+            failed = system.state.copy()
             system.state = saved
             system.set_load(t)
             dt *= 0.5
+            why = None
             if dt < opt.min_step:
+                why = f"step halved below min_step={opt.min_step:g}"
+            elif opt.max_newton_iterations is not None and \
+                    total_iters >= opt.max_newton_iterations:
+                why = f"Newton budget of {opt.max_newton_iterations} iterations spent"
+            if why is not None:
                 return StaticResult(
                     False, t, records, total_iters,
-                    f"Newton {res.reason} (residual {res.residual:.3g}) at load t={t_next:.6g};"
-                    f" step halved below min_step={opt.min_step:g}",
-                    time.perf_counter() - start)
+                    f"Newton {res.reason} (residual {res.residual:.3g}) at {where}; {why}",
+                    time.perf_counter() - start, failed)
             continue
         rec = StepRecord(t_next, res)
         records.append(rec)
@@ -147,8 +186,14 @@ def solve_static(
         if callback is not None:
             reason = callback(system, rec)
             if reason:
-                return StaticResult(False, t, records, total_iters, reason,
-                                    time.perf_counter() - start)
+                return StaticResult(False, t, records, total_iters, f"{reason} [{where}]",
+                                    time.perf_counter() - start, system.state.copy())
+        if (opt.max_newton_iterations is not None and total_iters >= opt.max_newton_iterations
+                and t < 1.0 - 1e-14):
+            return StaticResult(
+                False, t, records, total_iters,
+                f"Newton budget of {opt.max_newton_iterations} iterations spent after {where}",
+                time.perf_counter() - start, system.state.copy())
         if res.iterations < opt.grow_below:
             dt = min(opt.max_step, dt * 2.0)
     return StaticResult(True, 1.0, records, total_iters, "", time.perf_counter() - start)
