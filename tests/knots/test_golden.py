@@ -1,10 +1,15 @@
 """Golden regression: the canonical runs' curvature profiles against tests/golden/.
 
-Regenerated only by ``python -m tightknot.knots.golden --write``. Tolerances: the runs are
-deterministic on one machine (identical to round-off here); across machines the solver
-tolerance (scaled residual 1e-6) and float reordering move kappa D0 by far less than 1e-3,
-while a physics change (law, discretisation) moves it by 1e-2 or more: 2e-3 in kappa D0,
-0.05 in Lambda_OC and 1e-3 in stretch separate the two.
+Regenerated only by ``python -m tightknot.knots.golden --write``. The open knots are pulled
+by a fixed force (one equilibrium), but a knot in an open rod can slide along it at almost
+no cost, so where it settles along the rod moves with round-off of the path (by up to one
+edge, 0.15 D0, between solver versions here). Profiles are therefore compared as functions
+of s centred on the knot (interpolated onto the golden grid), not vertex by vertex:
+re-sampling a spike of the open 185 mm knot one edge off moved kappa D0 by 0.026 at most
+(RMS 0.013), so 0.04 (max) and 0.02 (RMS) separate that from a physics change (a change of
+law or discretisation moved kappa D0 by 0.05 to 0.3). Closed knots have no such slide. Headline
+numbers: 1e-3 in stretch and 0.05 in Lambda_OC and L/D (solver tolerance moves them by
+1e-4).
 """
 
 import json
@@ -13,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tightknot.knots.golden import CANONICAL, profile, run_canonical
+from tightknot.knots.golden import CANONICAL, TARGET_LAMBDA, profile, run_canonical
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"
 
@@ -22,9 +27,19 @@ GOLDEN = Path(__file__).resolve().parents[1] / "golden"
 def test_profile_matches_golden(name: str) -> None:
     gold = json.loads((GOLDEN / f"{name}.json").read_text())
     now = profile(run_canonical(name))
-    assert len(now["kappa"]) == len(gold["kappa"])
-    assert np.allclose(now["s"], gold["s"], atol=1e-6)
-    assert np.max(np.abs(np.asarray(now["kappa"]) - np.asarray(gold["kappa"]))) <= 2e-3
-    assert now["stretch"] == pytest.approx(gold["stretch"], abs=1e-3)
+    s0, k0 = np.asarray(gold["s"]), np.asarray(gold["kappa"])
+    s1, k1 = np.asarray(now["s"]), np.asarray(now["kappa"])
+    assert len(k1) == len(k0)
     if "lambda_oc" in gold:
+        inside = np.abs(s0) <= gold["lambda_oc"]  # the knot and a knot length of tail
+        diff = np.interp(s0[inside], s1, k1) - k0[inside]
+        assert np.max(np.abs(diff)) <= 0.04
+        assert np.sqrt(np.mean(diff**2)) <= 0.02
         assert now["lambda_oc"] == pytest.approx(gold["lambda_oc"], abs=0.05)
+        # The issue's check: the canonical forces bring the knots to the study's Lambda_OC.
+        assert now["lambda_oc"] == pytest.approx(TARGET_LAMBDA[name], abs=0.2)
+    else:
+        assert np.allclose(s1, s0, atol=1e-6)
+        assert np.max(np.abs(k1 - k0)) <= 2e-3  # no slide: vertex by vertex (see above)
+    assert now["stretch"] == pytest.approx(gold["stretch"], abs=1e-3)
+    assert now["L_over_D"] == pytest.approx(gold["L_over_D"], abs=0.05)

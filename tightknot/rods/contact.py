@@ -30,6 +30,7 @@ from tightknot.rods.contact_law import (
     kernel_table,
 )
 from tightknot.rods.model import Model
+from tightknot.solvers.contact_pattern import ContactPattern, pair_blocks
 from tightknot.warp_setup import init_warp
 
 #: Gauss-Legendre points and weights on [0, 1].
@@ -170,6 +171,12 @@ class ContactLayer:
         #: Edge rest lengths of the last evaluation (the load path changes them): the
         #: exclusion window of the step bound and of the checks is measured with these.
         self.rest = model.edge_rest_length.copy()
+        # Placeholders for the kernel's unused Hessian targets.
+        self._no_tables = (wp.full(1, -1, dtype=wp.int64, device=dev),
+                           wp.full(1, wp.vec3i(-1, -1, -1), dtype=wp.vec3i, device=dev),
+                           wp.full(model.vertex_count, wp.vec3i(-1, -1, -1), dtype=wp.vec3i,
+                                   device=dev))
+        self._no_csc = wp.zeros(1, dtype=wp.float64, device=dev)
 
     # -- buffers and detection -------------------------------------------------------------
     def _alloc(self, capacity: int) -> None:
@@ -212,11 +219,11 @@ class ContactLayer:
             self._alloc(self._capacity)
 
     # -- the energy term -------------------------------------------------------------------
-    def evaluate(
-        self, x: np.ndarray, rest: np.ndarray, want_grad: bool = True, want_hess: bool = True
-    ) -> tuple[float, np.ndarray | None, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
-        """Contact energy [J], gradient over vertex positions (N, 3) [N], Hessian COO
-        triplets over global dofs."""
+    def _launch(self, x: np.ndarray, rest: np.ndarray, want_grad: bool, hess_mode: int,
+                tables: tuple[wp.array, wp.array, wp.array] | None = None,
+                csc: wp.array | None = None) -> tuple:
+        """Detect and evaluate every candidate pair; hess_mode 0 none, 1 per-pair 144
+        entries, 2 added into the CSC data ``csc`` through the block ``tables``."""
         m = self.model
         dev = self.device
         self.rest = np.array(rest, dtype=np.float64)
@@ -225,34 +232,46 @@ class ContactLayer:
         pairs = self._candidates(wx, self._zero_dx, self._margin, arcs, rod_len)
         npairs = pairs.shape[0]
         grad = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
+        missing = wp.zeros(1, dtype=wp.int32, device=dev)
         if npairs == 0:
-            self.last_pairs = np.zeros((0, 2), dtype=np.int32)
-            self.last_overlap = np.zeros(0)
-            empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
-            return 0.0, (np.zeros((m.vertex_count, 3)) if want_grad else None), (
-                empty if want_hess else None)
+            return pairs, np.zeros(0), grad, None, np.zeros(0), missing
         energy = wp.zeros(npairs, dtype=wp.float64, device=dev)
         overlap = wp.zeros(npairs, dtype=wp.float64, device=dev)
-        hess = wp.zeros(npairs * 144 if want_hess else 1, dtype=wp.float64, device=dev)
+        hess = wp.zeros(npairs * 144 if hess_mode == 1 else 1, dtype=wp.float64, device=dev)
+        if tables is None:
+            tables = self._no_tables
+        if csc is None:
+            csc = self._no_csc
         wrest = wp.array(np.ascontiguousarray(rest), dtype=wp.float64, device=dev)
         wp.launch(ck.contact_pair_kernel, dim=npairs, device=dev,
                   inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, self._radius0,
                           self._poisson, self._modulus, self._gxi, self._gw,
                           self._law, self._line_table, self._point_table, wx, pairs, wrest,
                           arcs, rod_len, self._exclusion,
-                          int(want_grad or want_hess), int(want_hess)],
-                  outputs=[energy, grad, hess, overlap])
-        e_pair = energy.numpy()
+                          int(want_grad or hess_mode > 0), hess_mode, *tables],
+                  outputs=[energy, grad, hess, overlap, csc, missing])
+        return pairs, energy.numpy(), grad, hess, overlap.numpy(), missing
+
+    def evaluate(
+        self, x: np.ndarray, rest: np.ndarray, want_grad: bool = True, want_hess: bool = True
+    ) -> tuple[float, np.ndarray | None, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
+        """Contact energy [J], gradient over vertex positions (N, 3) [N], Hessian COO
+        triplets over global dofs."""
+        m = self.model
+        pairs, e_pair, grad, hess, overlap, _ = self._launch(x, rest, want_grad,
+                                                             int(want_hess))
+        self._remember(pairs, overlap)
+        if pairs.shape[0] == 0:
+            empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+            return 0.0, (np.zeros((m.vertex_count, 3)) if want_grad else None), (
+                empty if want_hess else None)
         e = float(e_pair.sum())
-        pr = pairs.numpy().astype(np.int64)
-        self.last_pairs = pr
-        self.last_overlap = overlap.numpy().copy()
         g = grad.numpy().copy() if want_grad else None
         coo = None
         if want_hess:
             # Only pairs that interact carry a Hessian (most candidates do not).
             active = np.flatnonzero(e_pair != 0.0)
-            pr = pr[active]
+            pr = self.last_pairs[active]
             npairs = active.size
             hvals = hess.numpy().reshape(-1, 144)[active].ravel()
             ev = m.edge_vertex.astype(np.int64)
@@ -263,6 +282,32 @@ class ContactLayer:
             cols = np.broadcast_to(dofs[:, None, :], (npairs, 12, 12)).ravel()
             coo = (rows, cols, hvals)
         return e, g, coo
+
+    def evaluate_into(self, x: np.ndarray, rest: np.ndarray, pattern: ContactPattern,
+                      data: wp.array) -> tuple[float, np.ndarray]:
+        """Energy [J] and gradient (N, 3) [N]; the Hessian is added into ``data``, the CSC
+        data array of ``pattern`` (zeroed by the caller). Blocks of new contacts grow the
+        pattern (``pattern.nnz`` changes: the caller reallocates ``data`` and calls again),
+        which is signalled by returning None for the gradient."""
+        tables = pattern.warp_tables(self.device)
+        pairs, e_pair, grad, _, overlap, missing = self._launch(x, rest, True, 2, tables,
+                                                                data)
+        self._remember(pairs, overlap)
+        if int(missing.numpy()[0]) > 0:
+            active = self.last_pairs[e_pair != 0.0]
+            pattern.grow(pair_blocks(self.model.edge_vertex, active, self.model.vertex_count))
+            return float(e_pair.sum()), None
+        return float(e_pair.sum()), grad.numpy().copy()
+
+    def active_blocks(self) -> np.ndarray:
+        """Vertex-block keys of the pairs that interacted at the last evaluation."""
+        active = self.last_pairs[self.last_overlap > 0.0]
+        return pair_blocks(self.model.edge_vertex, active, self.model.vertex_count)
+
+    def _remember(self, pairs: wp.array, overlap: np.ndarray) -> None:
+        self.last_pairs = pairs.numpy().astype(np.int64) if pairs.shape[0] else np.zeros(
+            (0, 2), dtype=np.int64)
+        self.last_overlap = overlap.copy()
 
     # -- no passing through ----------------------------------------------------------------
     def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:

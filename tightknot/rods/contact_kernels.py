@@ -133,10 +133,53 @@ def block(Fzz: wp.mat44d, ga0: wp.vec3d, ga1: wp.vec3d, ga2: wp.vec3d, ga3: wp.v
 
 
 @wp.func
-def add_hess(out: wp.array(dtype=wp.float64), base: int, v: int, w: int, m: wp.mat33d):
+def set_hess(out: wp.array(dtype=wp.float64), base: int, v: int, w: int, m: wp.mat33d):
     for i in range(3):
         for j in range(3):
-            out[base + (3 * v + i) * 12 + 3 * w + j] += m[i, j]
+            out[base + (3 * v + i) * 12 + 3 * w + j] = m[i, j]
+
+
+@wp.func
+def find_key(keys: wp.array(dtype=wp.int64), key: wp.int64) -> int:
+    """Index of ``key`` in the sorted array ``keys``, -1 if absent (binary search)."""
+    lo = int(0)
+    hi = keys.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if keys[mid] < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    if lo < keys.shape[0]:
+        if keys[lo] == key:
+            return lo
+    return -1
+
+
+@wp.func
+def scatter_block(block_keys: wp.array(dtype=wp.int64), block_cols: wp.array(dtype=wp.vec3i),
+                  vertex_rank: wp.array(dtype=wp.vec3i), vr: int, vc: int, m: wp.mat33d,
+                  csc_out: wp.array(dtype=wp.float64), missing_out: wp.array(dtype=wp.int32)):
+    """Add the 3 x 3 block of vertex rows ``vr``, columns ``vc`` into the CSC data.
+
+    Block table (tightknot.solvers.contact_pattern): key vr * V + vc; block_cols[k][j] is
+    the data slot of the first free row of vr in the column of component j of vc (-1 if
+    that component is fixed); vertex_rank[vr][i] the offset of component i among the free
+    components of vr (-1 if fixed): the free rows of one vertex are consecutive in a
+    column. A block missing from the table is counted in ``missing_out`` (the caller
+    grows the pattern and evaluates again)."""
+    key = wp.int64(vr) * wp.int64(vertex_rank.shape[0]) + wp.int64(vc)
+    k = find_key(block_keys, key)
+    if k < 0:
+        wp.atomic_add(missing_out, 0, 1)
+        return
+    cols = block_cols[k]
+    rank = vertex_rank[vr]
+    for j in range(3):
+        if cols[j] >= 0:
+            for i in range(3):
+                if rank[i] >= 0:
+                    wp.atomic_add(csc_out, cols[j] + rank[i], m[i, j])
 
 
 @wp.kernel
@@ -235,11 +278,18 @@ def contact_pair_kernel(
     edge_exclusion_in: wp.array(dtype=wp.float64),
     want_grad: int,
     want_hess: int,
+    # Hessian target (want_hess = 1: 144 entries per pair in hess_out; 2: added into the
+    # CSC data array csc_out through the block table, see scatter_block):
+    block_keys: wp.array(dtype=wp.int64),
+    block_cols: wp.array(dtype=wp.vec3i),
+    vertex_rank: wp.array(dtype=wp.vec3i),
     # Out:
     energy_out: wp.array(dtype=wp.float64),
     grad_out: wp.array(dtype=wp.vec3d),
     hess_out: wp.array(dtype=wp.float64),
     overlap_out: wp.array(dtype=wp.float64),
+    csc_out: wp.array(dtype=wp.float64),
+    missing_out: wp.array(dtype=wp.int32),
 ):
     p = wp.tid()
     pr = pairs_in[p]
@@ -342,9 +392,25 @@ def contact_pair_kernel(
     g2 = wp.vec3d()
     g3 = wp.vec3d()
     base = p * 144
-    if want_hess != 0:
-        for k in range(144):
-            hess_out[base + k] = f64(0.0)
+    # Hessian accumulators over the Gauss pairs (see the block assembly after the loop):
+    # moments of H_rr in (1, xg, xh, xg^2, xh^2, xg xh), of H_ra and H_rb in (1, xg, xh),
+    # and the sums of H_aa, H_bb, H_ab.
+    M0 = wp.mat33d()
+    Mg = wp.mat33d()
+    Mh = wp.mat33d()
+    Mgg = wp.mat33d()
+    Mhh = wp.mat33d()
+    Mgh = wp.mat33d()
+    A0 = wp.mat33d()
+    Ag = wp.mat33d()
+    Ah = wp.mat33d()
+    B0 = wp.mat33d()
+    Bg = wp.mat33d()
+    Bh = wp.mat33d()
+    Saa = wp.mat33d()
+    Sbb = wp.mat33d()
+    Sab = wp.mat33d()
+    any_hess = int(0)
     xmax = f64(-1.0e30)
     zero3 = wp.vec3d()
     for gi in range(ng):
@@ -441,19 +507,56 @@ def contact_pair_kernel(
             Hbb = block(Fzz, zero3, zero3, gb_lb, dq_b, zero3, zero3, gb_lb, dq_b) + (
                 Fz[2] / lb) * Pb + Fz[3] * Hq_bb
             Hab = block(Fzz, zero3, ga_la, zero3, dq_a, zero3, zero3, gb_lb, dq_b) + Fz[3] * Hq_ab
-            # Map to the 4 vertices: coefficient of (r, e_a, e_b) in each vertex.
-            cr = wp.vec4d(f64(1.0) - xg, xg, -(f64(1.0) - xh), -xh)
-            ca = wp.vec4d(f64(-1.0), f64(1.0), f64(0.0), f64(0.0))
-            cb = wp.vec4d(f64(0.0), f64(0.0), f64(-1.0), f64(1.0))
-            Har = wp.transpose(Hra)
-            Hbr = wp.transpose(Hrb)
-            Hba = wp.transpose(Hab)
-            for v in range(4):
-                for w in range(4):
-                    m = (cr[v] * cr[w]) * Hrr + (cr[v] * ca[w]) * Hra + (cr[v] * cb[w]) * Hrb
-                    m = m + (ca[v] * cr[w]) * Har + (ca[v] * ca[w]) * Haa + (ca[v] * cb[w]) * Hab
-                    m = m + (cb[v] * cr[w]) * Hbr + (cb[v] * ca[w]) * Hba + (cb[v] * cb[w]) * Hbb
-                    add_hess(hess_out, base, v, w, m)
+            # Accumulate; the map to the vertices is linear in (xg, xh), done once below.
+            any_hess = 1
+            M0 = M0 + Hrr
+            Mg = Mg + xg * Hrr
+            Mh = Mh + xh * Hrr
+            Mgg = Mgg + (xg * xg) * Hrr
+            Mhh = Mhh + (xh * xh) * Hrr
+            Mgh = Mgh + (xg * xh) * Hrr
+            A0 = A0 + Hra
+            Ag = Ag + xg * Hra
+            Ah = Ah + xh * Hra
+            B0 = B0 + Hrb
+            Bg = Bg + xg * Hrb
+            Bh = Bh + xh * Hrb
+            Saa = Saa + Haa
+            Sbb = Sbb + Hbb
+            Sab = Sab + Hab
+    if want_hess != 0 and any_hess != 0:
+        # Vertex blocks H_vw = sum_gh C_v^T H_Y C_w with the coefficients of (r, e_a, e_b)
+        # in vertex v: c_r = alpha_v + beta_v xg + gamma_v xh (r = (1-xg) xa0 + xg xa1
+        # - (1-xh) xb0 - xh xb1), c_a = (-1, 1, 0, 0), c_b = (0, 0, -1, 1).
+        al = wp.vec4d(f64(1.0), f64(0.0), f64(-1.0), f64(0.0))
+        be = wp.vec4d(f64(-1.0), f64(1.0), f64(0.0), f64(0.0))
+        ga = wp.vec4d(f64(0.0), f64(0.0), f64(1.0), f64(-1.0))
+        ca = wp.vec4d(f64(-1.0), f64(1.0), f64(0.0), f64(0.0))
+        cb = wp.vec4d(f64(0.0), f64(0.0), f64(-1.0), f64(1.0))
+        verts = wp.vec4i(va[0], va[1], vb[0], vb[1])
+        for v in range(4):
+            Ra_v = al[v] * A0 + be[v] * Ag + ga[v] * Ah  # sum c_r,v H_ra
+            Rb_v = al[v] * B0 + be[v] * Bg + ga[v] * Bh  # sum c_r,v H_rb
+            for w in range(v, 4):
+                Ra_w = al[w] * A0 + be[w] * Ag + ga[w] * Ah
+                Rb_w = al[w] * B0 + be[w] * Bg + ga[w] * Bh
+                m = (al[v] * al[w]) * M0 + (al[v] * be[w] + be[v] * al[w]) * Mg
+                m = m + (al[v] * ga[w] + ga[v] * al[w]) * Mh + (be[v] * be[w]) * Mgg
+                m = m + (ga[v] * ga[w]) * Mhh + (be[v] * ga[w] + ga[v] * be[w]) * Mgh
+                m = m + ca[w] * Ra_v + cb[w] * Rb_v
+                m = m + ca[v] * wp.transpose(Ra_w) + cb[v] * wp.transpose(Rb_w)
+                m = m + (ca[v] * ca[w]) * Saa + (cb[v] * cb[w]) * Sbb
+                m = m + (ca[v] * cb[w]) * Sab + (cb[v] * ca[w]) * wp.transpose(Sab)
+                if want_hess == 1:
+                    set_hess(hess_out, base, v, w, m)
+                    if w != v:
+                        set_hess(hess_out, base, w, v, wp.transpose(m))
+                else:
+                    scatter_block(block_keys, block_cols, vertex_rank, verts[v], verts[w], m,
+                                  csc_out, missing_out)
+                    if w != v:
+                        scatter_block(block_keys, block_cols, vertex_rank, verts[w], verts[v],
+                                      wp.transpose(m), csc_out, missing_out)
     energy_out[p] = energy
     overlap_out[p] = xmax
     if want_grad != 0:

@@ -23,6 +23,7 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.elastic import ElasticForces
 from tightknot.rods.model import Model
 from tightknot.rods.state import State
+from tightknot.solvers.contact_pattern import ContactPattern
 from tightknot.solvers.linear import SparsePattern
 
 
@@ -123,6 +124,7 @@ class RodSystem:
         self.length_scale = float(model.edge_radius.min())
         self.t = 0.0
         self.last_split = EnergySplit()
+        self._cpattern: ContactPattern | None = None
         self._trial: tuple[np.ndarray, ...] | None = None
         self.set_load(0.0)
 
@@ -192,8 +194,28 @@ class RodSystem:
         coo_parts = []
         if grad is not None:
             grad[m.position_dofs] -= self.f_ext
+        # Terms that add their Hessian straight into the CSC data (the contact layer) share
+        # one pattern that grows with the contact set (tightknot.solvers.contact_pattern).
+        direct = [t for t in self.extra_terms if want_hess and hasattr(t, "evaluate_into")]
+        cdata = None
+        results = {}
+        if direct:
+            if self._cpattern is None:
+                self._cpattern = ContactPattern(m, self.pattern)
+            while True:
+                cdata = wp.zeros(self._cpattern.nnz, dtype=wp.float64, device=m.device)
+                for term in direct:
+                    results[id(term)] = term.evaluate_into(x, self.rest, self._cpattern, cdata)
+                    if results[id(term)][1] is None:
+                        break  # new contact blocks: the pattern grew, assemble again
+                else:
+                    break
         for term in self.extra_terms:
-            e_k, g_k, h_k = term.evaluate(x, self.rest, want_grad or want_hess, want_hess)
+            if id(term) in results:
+                e_k, g_k = results[id(term)]
+                h_k = None
+            else:
+                e_k, g_k, h_k = term.evaluate(x, self.rest, want_grad or want_hess, want_hess)
             split.extra[term.name] = e_k
             if grad is not None and g_k is not None:
                 grad[m.position_dofs] += g_k
@@ -212,13 +234,27 @@ class RodSystem:
         hmat = None
         if want_hess:
             data = self._hess.numpy()[: self.pattern.nnz].copy()
+            pattern = self.pattern
+            if cdata is not None:
+                pattern = self._cpattern
+                full = cdata.numpy()
+                full[pattern.elastic_slot] += data
+                data = full
             if self.inertia is not None:
                 w = self.inertia.mass / self.inertia.dt**2
-                data[self.pattern.diag_slot] += w[self.pattern.free_dofs]
-            hmat = self.pattern.matrix(data)
+                data[pattern.diag_slot] += w[self.pattern.free_dofs]
+            hmat = pattern.matrix(data)
             if coo_parts:
                 hmat = hmat + self._coo_free(coo_parts)
         return split.total, g_free, hmat
+
+    def compact_pattern(self) -> None:
+        """Drop contact blocks that no longer interact (call between load steps: a pattern
+        that only grows would carry stale zeros into every later factorization)."""
+        if self._cpattern is None:
+            return
+        keys = [t.active_blocks() for t in self.extra_terms if hasattr(t, "active_blocks")]
+        self._cpattern.reset(np.concatenate(keys) if keys else np.zeros(0, np.int64))
 
     def _coo_free(self, parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> sp.csc_matrix:
         fi = self.pattern.free_index
