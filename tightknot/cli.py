@@ -270,11 +270,22 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return EXIT_OK if summary.get("passed", False) else EXIT_PHYSICS
 
 
+_TOP_EXAMPLES = """examples:
+  tightknot demo                          # the study's three knots into runs/demo/
+  tightknot tie closed --out runs/closed  # one knot, one run folder
+  tightknot view runs/closed/run.rrd      # look at every load step
+  tightknot COMMAND --help                # each command's options and examples
+
+exit codes: 0 success, 1 the physics failed (reason printed), 2 bad input.
+"""
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of every subcommand."""
     parser = _Parser(
         prog="tightknot",
         description="Tight physical knots in elastic rods: discrete elastic rods in Warp.",
+        epilog=_TOP_EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"tightknot {__version__}")

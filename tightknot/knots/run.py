@@ -212,20 +212,39 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
     return KnotRun(scene, res, rep, contact, summary)
 
 
+#: Tail shown beyond the knot in an open knot's tube picture, in rest diameters D0.
+TUBE_TAIL_D0 = 1.5
+
+
 def draw_tube(run: KnotRun, path: Path, field: str = "kappa_D0") -> Path:
-    """The final rod of ``run`` as a 3D tube (deformed radii) coloured by ``field``."""
+    """The final rod of ``run`` as a 3D tube (deformed radii) coloured by ``field``.
+
+    An open knot is drawn from TUBE_TAIL_D0 before its first contact to as far after its
+    last (the long straight tails would shrink the knot to a dot); without contact, whole.
+    """
     from tightknot.viz.tube_figure import render_tube
 
     system = run.result.system
     x = system.state.x
     _, r_v = vertex_radii(run.scene, x, system.rest)
     values, at = rod_field(check_color_field(field), run.scene, x, system.rest, run.contact)
+    if not run.scene.closed:
+        touching = np.nonzero(run.contact.contact_width_fraction > 0)[0]
+        if touching.size:
+            s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
+            tail = TUBE_TAIL_D0 * run.scene.diameter
+            i0 = int(np.searchsorted(s, s[touching[0]] - tail))
+            i1 = int(np.searchsorted(s, s[touching[-1]] + tail)) + 1
+            x, r_v = x[i0:i1], r_v[i0:i1]
+            values = values[i0:i1] if at == "vertex" else values[i0:i1 - 1]
     s = run.summary
     what = (f"L0/D0 = {run.scene.rest_length / run.scene.diameter:.2f}" if run.scene.closed
             else f"L0 = {run.scene.rest_length * 1e3:.0f} mm, F = {s['pull_force_N']:.3g} N" + (
                 "" if s.get("lambda_oc") is None else f", Lambda_OC = {s['lambda_oc']:.2f}"))
     title = f"{run.scene.name.replace('_', ' ')}: {what}, {s['knot_type']}"
-    return render_tube(path, x, r_v, run.scene.closed, values, field, title, field_at=at)
+    view = (60.0, -60.0) if run.scene.closed else (70.0, -90.0)
+    return render_tube(path, x, r_v, run.scene.closed, values, field, title, field_at=at,
+                       view=view)
 
 
 def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> list[Path]:

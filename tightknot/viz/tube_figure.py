@@ -67,10 +67,11 @@ def render_tube(path: str | Path, x: np.ndarray, radii: np.ndarray | float, clos
                 field: np.ndarray, field_name: str, title: str = "",
                 limits: tuple[float, float] | None = None, *,
                 field_at: FieldLocation | None = None, sides: int = 16,
-                dpi: int = 130) -> Path:
+                view: tuple[float, float] = (60.0, -60.0), dpi: int = 130) -> Path:
     """Draw the tube of centerline ``x`` (N, 3) [m] with ``radii`` [m] (scalar or per vertex)
     coloured by ``field`` (per vertex or per edge; a name of
-    :data:`tightknot.viz.rerun_log.ROD_FIELDS`) and save it as a PNG at ``path``."""
+    :data:`tightknot.viz.rerun_log.ROD_FIELDS`) and save it as a PNG at ``path``.
+    ``view``: camera elevation and azimuth [degrees]."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -102,16 +103,19 @@ def render_tube(path: str | Path, x: np.ndarray, radii: np.ndarray | float, clos
     fig = plt.figure(figsize=(6.0, 5.2))
     ax = fig.add_subplot(projection="3d")
     scale = 1e3  # mm on the axes: the study's unit
+    # Edges in the face colour: hairline seams between the quads disappear.
     coll = Poly3DCollection((quads * scale).reshape(-1, 4, 3), facecolors=face.reshape(-1, 4),
-                            linewidths=0.0)
+                            edgecolors=face.reshape(-1, 4), linewidths=0.3)
     ax.add_collection3d(coll)
     lo = (p - r_v[:, None]).min(axis=0) * scale
     hi = (p + r_v[:, None]).max(axis=0) * scale
-    mid, half = (lo + hi) / 2, (hi - lo).max() / 2
-    for setter, m in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, strict=True):
-        setter(m - half, m + half)
-    ax.set_box_aspect((1, 1, 1))
-    ax.view_init(elev=60, azim=-60)
+    for setter, a, b in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), lo, hi, strict=True):
+        setter(a, b)
+    # Equal scales on the three axes with a box fitted to the data (a cube would leave an
+    # elongated knot small in an empty box); zoom fills the frame.
+    ax.set_box_aspect(hi - lo, zoom=1.1)
+    ax.set_proj_type("ortho")
+    ax.view_init(elev=view[0], azim=view[1])
     ax.set_axis_off()
     sm = cm.ScalarMappable(norm=colors.Normalize(*lims), cmap=cmap)
     label = {"kappa_D0": r"curvature $\kappa D_0$", "area_ratio": r"section area $A/A_0$",
