@@ -54,7 +54,8 @@ class NewtonOptions:
 
     Attributes:
         residual_tol: converged when the scaled residual is below this [-].
-        step_tol: a step below this (scaled) with the residual still large is stagnation.
+        step_tol: a step below this (scaled) that did not cut the residual by
+            ``stall_factor`` is stagnation.
         max_iterations: iteration limit.
         armijo: sufficient-decrease constant of the line search.
         max_backtracks: line-search halvings before the shift is raised instead.
@@ -201,7 +202,9 @@ def newton_solve(
             mu = 0.0 if mu <= opt.shift_trust else mu / 4.0
         if res <= opt.residual_tol:
             return NewtonResult(True, it, res, step, energy, "converged", history)
-        if step <= opt.step_tol:
+        # A tiny step that still cut the residual (a small correction, e.g. under the
+        # stiff inertia of a short time step) is progress; one that did not is stagnation.
+        if step <= opt.step_tol and res > opt.stall_factor * history[-2]:
             return NewtonResult(False, it, res, step, energy, "stagnated", history)
         best.append(min(best[-1], res))
         energies.append(energy)
