@@ -32,6 +32,17 @@ def _length(x: Any, closed: bool) -> float:
     return float(np.linalg.norm(e, axis=1).sum())
 
 
+def _phases(res: Any) -> dict:
+    """Newton iterations, load steps and wall time of each continuation phase; the rest of
+    the iterations (the relaxation of the start, and an open knot's force search) under
+    ``other``: where the iterations go."""
+    out = {name: {"newton_iterations": r.newton_iterations, "load_steps": len(r.steps),
+                  "wall_time_s": r.wall_time_s} for name, r in res.phases.items()}
+    out["other"] = {"newton_iterations": res.newton_iterations
+                    - sum(r.newton_iterations for r in res.phases.values())}
+    return out
+
+
 def warm_up(device: str = "cpu") -> float:
     """Tie a small closed and a small open trefoil (kernels loaded or compiled); seconds."""
     t0 = time.perf_counter()
@@ -51,7 +62,7 @@ def closed_case(nodes: int = 200, device: str = "cpu") -> dict:
             "wall_time_s": wall, "cpu_time_s": cpu, "converged": res.converged,
             "failure": res.failure,
             "knot_types": sorted(set(res.knot_types)),
-            "newton_iterations": res.newton_iterations,
+            "newton_iterations": res.newton_iterations, "phases": _phases(res),
             "stretch": _length(x, True) / scene.rest_length}
 
 
@@ -68,7 +79,8 @@ def open_case(nodes: int = 300, length: float = 0.185, target: float = 10.1,
             "target_lambda_oc": target, "wall_time_s": wall, "cpu_time_s": cpu,
             "converged": res.converged,
             "failure": res.failure, "knot_types": sorted(set(res.knot_types)),
-            "newton_iterations": res.newton_iterations, "lambda_oc": lam,
+            "newton_iterations": res.newton_iterations, "phases": _phases(res),
+            "lambda_oc": lam,
             "pull_force_N": res.pull_force_N}
 
 
@@ -139,6 +151,10 @@ def _command(args) -> int:  # noqa: ANN001
               f"(target {r['target_s']:g} s, CPU {r['cpu_time_s']:.2f} s) {verdict}; "
               f"{r['newton_iterations']} Newton "
               f"iterations, types {r['knot_types']}{extra}")
+        ph = ", ".join(f"{k} {v['newton_iterations']}" for k, v in r["phases"].items())
+        print(f"{'':>15s} Newton iterations by phase: {ph} (other: relaxation of the start"
+              f"{', force search' if r['case'] == 'open_trefoil' else ''}); "
+              f"{1e3 * r['cpu_time_s'] / max(r['newton_iterations'], 1):.1f} ms CPU each")
     if not result["default_sizes"]:
         print("(non-default sizes: the targets are for 200 and 300 vertices)")
     if out is not None:
