@@ -87,6 +87,7 @@ def test_tie_run_folder_holds_every_output(closed_run: Path) -> None:
         assert key in data, key
     cfg = json.loads((closed_run / "config.json").read_text())
     assert cfg["knot"] == "closed" and cfg["nodes"] == 60 and cfg["color_by"] == "kappa_D0"
+    assert cfg["device"] == "cpu"  # what ran, not "the default"
 
 
 def test_tie_rrd_has_rod_contacts_series_steps_and_final_centerline(closed_run: Path) -> None:
@@ -211,6 +212,30 @@ def test_tie_bad_outputs_fail_before_the_run(tmp_path, capsys) -> None:
         assert words in capsys.readouterr().err, (extra, words)
         # Refused before any work: not even the run folder was made.
         assert not out.exists(), extra
+
+
+def test_tie_flags_override_the_config_file(tmp_path) -> None:
+    from tightknot.cli import tie_config
+
+    cfg = tmp_path / "c.json"
+    cfg.write_text(json.dumps({"knot": "open", "length": 0.125, "target_lambda": 10.1,
+                               "nodes": 120, "youngs_modulus": 2e6}))
+
+    def resolved(*argv: str):
+        return tie_config(build_parser().parse_args(["tie", *argv]))
+
+    same = resolved("--config", str(cfg))
+    assert (same.knot, same.length, same.target_lambda, same.nodes) == ("open", 0.125, 10.1, 120)
+    more = resolved("--config", str(cfg), "--nodes", "200", "--color-by", "contact_width")
+    assert more.nodes == 200 and more.youngs_modulus == 2e6
+    assert more.color_by == "contact_width_fraction"
+    # A load flag replaces the file's load (an open knot takes exactly one).
+    forced = resolved("--config", str(cfg), "--force", "3")
+    assert forced.force == 3.0 and forced.target_lambda is None and forced.length == 0.125
+    # Another knot drops the file's knot-specific values (its nodes, length and load).
+    closed = resolved("closed", "--config", str(cfg))
+    assert closed.knot == "closed" and closed.nodes == 200 and closed.length is None
+    assert closed.youngs_modulus == 2e6
 
 
 def test_tie_default_run_folder(tmp_path, monkeypatch) -> None:

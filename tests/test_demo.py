@@ -4,7 +4,7 @@ import json
 
 import numpy as np
 
-from tightknot.viz.rrd_read import entity_paths, last_points3d
+from tightknot.viz.rrd_read import entity_paths, last_points3d, scalar_series, steps
 
 
 def test_demo_outputs(tmp_path) -> None:
@@ -37,3 +37,15 @@ def test_demo_outputs(tmp_path) -> None:
         assert any(p.startswith(entity) for p in paths), (entity, paths)
     pts = last_points3d(rrd, "/open_185mm/rod/vertices")
     assert pts.shape == (150, 3) and np.isfinite(pts).all()
+    # The open knots' series: end-to-end distance, pulling force, Lambda_OC once in contact.
+    for key in ("end_to_end", "pulling_force", "lambda_oc"):
+        assert f"/plots/open_125mm/{key}" in paths, key
+    # Each knot's rod is logged once per converged load step of its tightening, plus once for
+    # the final state the force search toward Lambda_OC ends in (not a load step).
+    closed_steps = steps(rrd, "/closed/rod/vertices", "Points3D:positions")
+    assert len(closed_steps) == closed["load_steps"]
+    tight_steps = steps(rrd, "/open_125mm/rod/vertices", "Points3D:positions")
+    assert len(tight_steps) == tight["load_steps"] + 1
+    # The final force of the search is the last logged pulling force (float32 in rerun).
+    _, force = scalar_series(rrd, "/plots/open_125mm/pulling_force")
+    assert abs(force[-1] - tight["pull_force_N"]) <= 1e-4 * tight["pull_force_N"]

@@ -7,6 +7,7 @@ a topology change) with the reason printed, 2 bad input.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 from collections.abc import Sequence
@@ -138,7 +139,10 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     cfg = tie_config(args)
     # Every output path is checked before any work (issue 6: fail early, not after minutes).
     outs = plan_outputs(cfg.scene_name, args.out, args.json, args.rrd, args.figures)
-    device = resolve_device(cfg.device)
+    # The device actually used goes into config.json (None would mean "cpu" here but
+    # perhaps not in a later version): the file records what ran.
+    cfg = dataclasses.replace(cfg, device=resolve_device(cfg.device))
+    device = cfg.device
     material = Material(cfg.youngs_modulus, cfg.poisson, cfg.density)
     if cfg.knot == "closed":
         scene = closed_trefoil(cfg.l0_over_d0, cfg.diameter, cfg.nodes, material, device=device)

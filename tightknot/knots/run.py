@@ -18,7 +18,7 @@ from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal import load_ideal_trefoil
 from tightknot.knots.measure import analyze_centerline
 from tightknot.knots.scenes import KnotScene, vertex_radii
-from tightknot.knots.tie import TieResult, lambda_oc, tie, tie_to_lambda
+from tightknot.knots.tie import TieResult, end_reaction, lambda_oc, tie, tie_to_lambda
 from tightknot.rods.contact import ContactReport, contact_report
 from tightknot.solvers.system import RodSystem
 
@@ -77,7 +77,7 @@ def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
               color_by: str = "kappa_D0") -> None:
     """Log the rod (tube coloured by ``color_by``, deformed radii) and its contact pairs
     (coloured by peak p/E) at the logger's current step; open knots also get their
-    end-to-end distance [m] and Lambda_OC [1] (when in contact)."""
+    end-to-end distance [m], pulling force [N] and Lambda_OC [1] (when in contact)."""
     x = system.state.x
     r_e, r_v = vertex_radii(scene, x, system.rest)
     rep = contact_report(scene.contact, x)
@@ -88,7 +88,10 @@ def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
     ib = rep.pairs[:, 1].astype(int)
     log.log_contacts(f"{name}/contacts", x[ia], x[ib], rep.peak_pressure_over_E[ia])
     if not scene.closed:
-        scalars = {f"{name}/end_to_end": float(np.linalg.norm(x[-1] - x[0]))}
+        # The force the pulled end carries (its reaction: the dead load of a force-driven
+        # pull, what holds a moved end where it is otherwise) [N].
+        scalars = {f"{name}/end_to_end": float(np.linalg.norm(x[-1] - x[0])),
+                   f"{name}/pulling_force": end_reaction(system)}
         lam = lambda_oc(x, scene.diameter, r_v, tol=CONTACT_TOL)
         if np.isfinite(lam):
             scalars[f"{name}/lambda_oc"] = lam
