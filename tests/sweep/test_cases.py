@@ -1,0 +1,70 @@
+"""Sweep cases: canonical parameters, stable ids, grids, and clear errors on bad input."""
+
+import json
+
+import pytest
+
+from tightknot.sweep.cases import Case, canonical, case_id, grid
+
+
+def test_the_id_depends_on_the_physics_not_on_spelling_or_order() -> None:
+    a = Case.of({"knot": "open", "target_lambda": [13, 15, 14], "nodes": 150})
+    # Same case: defaults written out, ints as floats, levels in another order.
+    b = Case.of({"nodes": 150.0, "knot": "open", "length": 0.185, "contact": "compliant",
+                 "target_lambda": [15.0, 14.0, 13.0]})
+    assert a.id == b.id
+    assert a.params == b.params
+    # Levels are stored loosest first: Lambda_OC decreasing, forces increasing.
+    assert a.params["target_lambda"] == [15.0, 14.0, 13.0]
+    assert Case.of({"knot": "open", "pull_force": [3, 1, 2]}).params["pull_force"] == [1, 2, 3]
+    # Any change of a parameter gives another id.
+    assert Case.of({"knot": "open", "target_lambda": [13, 15, 14], "nodes": 151}).id != a.id
+    assert Case.of({"knot": "open", "target_lambda": [13, 15], "nodes": 150}).id != a.id
+    # The canonical form is a fixed point, JSON round-trips, and the id is 16 hex digits.
+    assert canonical(a.params) == a.params
+    assert json.loads(json.dumps(a.params)) == a.params
+    assert case_id(json.loads(json.dumps(a.params))) == a.id
+    assert len(a.id) == 16 and int(a.id, 16) >= 0
+
+
+def test_grid_is_the_product_of_the_axes_without_duplicates() -> None:
+    cases = grid({"knot": "closed", "nodes": 60}, l0_over_d0=[16.37, 18, 20],
+                 contact=["compliant", "rigid"])
+    assert len(cases) == 6
+    assert len({c.id for c in cases}) == 6
+    assert [c.params["l0_over_d0"] for c in cases[:2]] == [16.37, 16.37]
+    # 18 and 18.0 are one case.
+    assert len(grid({"knot": "closed"}, l0_over_d0=[18, 18.0])) == 1
+    assert "l0_over_d0=18" in cases[2].label()
+
+
+@pytest.mark.parametrize(("params", "words"), [
+    ({"knot": "loop"}, "knot must be one of"),
+    ({"knot": "closed", "nodes": 10}, "nodes must be a whole number >= 24"),
+    ({"knot": "closed", "nodes": 40.5}, "nodes must be a whole number"),
+    ({"knot": "closed", "l0_over_d0": 5}, "l0_over_d0 must be >= 10"),
+    ({"knot": "closed", "poisson": 0.7}, "poisson must be in (-1, 0.5]"),
+    ({"knot": "closed", "youngs_modulus": float("nan")}, "youngs_modulus must be a finite"),
+    ({"knot": "closed", "youngs_modulus": -1.0}, "youngs_modulus must be > 0 Pa"),
+    ({"knot": "closed", "contact": "sticky"}, "contact must be one of"),
+    ({"knot": "closed", "pull_force": [1.0]}, "unknown parameter(s) ['pull_force']"),
+    ({"knot": "open"}, "exactly one level list"),
+    ({"knot": "open", "pull_force": [1.0], "target_lambda": [14]}, "exactly one level list"),
+    ({"knot": "open", "pull_force": []}, "non-empty list"),
+    ({"knot": "open", "pull_force": [1.0, -2.0]}, "pull_force[1] must be > 0 N"),
+    ({"knot": "open", "target_lambda": [14, 14.0]}, "lists a level twice"),
+    ({"knot": "open", "length": 0.05, "pull_force": [1.0]}, "length must be >= 10 D0"),
+    ({"knot": "open", "twist": "yes", "pull_force": [1.0]}, "twist must be true or false"),
+])
+def test_bad_parameters_are_refused_with_their_name_and_range(params: dict,
+                                                              words: str) -> None:
+    with pytest.raises(ValueError) as err:
+        Case.of(params)
+    assert words in str(err.value)
+
+
+def test_a_grid_axis_cannot_repeat_a_fixed_parameter() -> None:
+    with pytest.raises(ValueError, match="both as a fixed parameter and as a sweep axis"):
+        grid({"knot": "closed", "nodes": 60}, nodes=[60, 80])
+    with pytest.raises(ValueError, match="non-empty list"):
+        grid({"knot": "closed"}, nodes=[])

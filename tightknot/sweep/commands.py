@@ -1,0 +1,209 @@
+"""``tightknot sweep``: sweep a knot scene's parameters into a resumable store.
+
+Every option that takes several values is a sweep axis (the cases are their Cartesian
+product); an open knot's ``--lambda`` or ``--force`` levels are one continuation path per
+case (tie once, then pull level by level). Results go to ``--out DIR`` (one JSON file per
+case, plus ``index.json``); running the same command again skips the finished cases.
+Exit codes: 0 every case ok, 1 a case failed (its reason printed), 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+EXIT_OK, EXIT_PHYSICS = 0, 1
+
+_EXAMPLES = """examples:
+  # the 185 mm open trefoil pulled through 20 knot lengths along one path
+  tightknot sweep open --length 0.185 --lambda 15 14.75 14.5 14.25 14 13.75 13.5 13.25 \\
+      13 12.75 12.5 12.25 12 11.75 11.5 11.25 11 10.75 10.5 10.25 --out runs/sweep185
+  # pulling forces [N] for two rest lengths and two meshes (4 paths, 2 worker processes)
+  tightknot sweep open --length 0.185 0.16 --nodes 150 300 --force 2 3 4 5 --out runs/f \\
+      --workers 2
+  # closed trefoils of three lengths, compliant and rigid-tube contact
+  tightknot sweep closed --l0-over-d0 16.37 18 20 --contact compliant rigid --out runs/c
+  # the same on a Dask cluster (pip install tightknot[distributed])
+  tightknot sweep closed --l0-over-d0 16.37 18 20 --out runs/c --executor dask \\
+      --scheduler tcp://scheduler:8786
+  # interrupted? run the same command again: finished cases are skipped
+  tightknot sweep closed --l0-over-d0 16.37 18 20 --out runs/c --json runs/c.json
+
+store: DIR/index.json lists every case (id, params, status); DIR/cases/ID.json holds its
+record (the knot summary of 'tightknot tie'; for an open knot one entry per level).
+"""
+
+#: Command-line option -> case parameter, for the options that may be sweep axes.
+_AXES = {
+    "nodes": "nodes", "diameter": "diameter", "youngs_modulus": "youngs_modulus",
+    "poisson": "poisson", "contact": "contact", "l0_over_d0": "l0_over_d0",
+    "length": "length",
+}
+
+
+def register(subparsers: Any) -> None:
+    """Add ``tightknot sweep`` to an argparse ``subparsers``."""
+    from tightknot.sweep.cases import CONTACT_LAWS
+    from tightknot.sweep.executors import EXECUTORS
+
+    p = subparsers.add_parser(
+        "sweep", help="sweep knot parameters (tightness, length, E, mesh...) into a store",
+        description="Run a sweep of the study's knots: every multi-valued option is an "
+        "axis, an open knot's --lambda/--force levels are one continuation path. One JSON "
+        "file per case in --out, written atomically, with an index; an interrupted sweep "
+        "started again skips the finished cases.",
+        epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("knot", choices=["closed", "open"], help="closed or open trefoil")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="the store folder (created; its parent must exist)")
+    p.add_argument("--l0-over-d0", type=float, nargs="+", metavar="R",
+                   help="closed: L0/D0 values (16.37)")
+    p.add_argument("--length", type=float, nargs="+", metavar="L0",
+                   help="open: rest lengths L0 [m] (0.185)")
+    levels = p.add_mutually_exclusive_group()
+    levels.add_argument("--lambda", dest="target_lambda", type=float, nargs="+",
+                        metavar="LAMBDA", help="open: target knot lengths Lambda_OC, "
+                        "one path visiting them from the loosest")
+    levels.add_argument("--force", dest="pull_force", type=float, nargs="+", metavar="F",
+                        help="open: pulling forces [N], one path from the weakest")
+    p.add_argument("--lambda-tolerance", type=float, default=None,
+                   help="open: how close a --lambda level is reached (0.1)")
+    p.add_argument("--nodes", type=int, nargs="+", help="vertices (200 closed, 300 open)")
+    p.add_argument("--diameter", type=float, nargs="+", help="rest diameter D0 [m] (8.5e-3)")
+    p.add_argument("--youngs-modulus", type=float, nargs="+", metavar="E",
+                   help="Young's modulus E [Pa] (1.25e6)")
+    p.add_argument("--poisson", type=float, nargs="+", metavar="NU",
+                   help="Poisson ratio in (-1, 0.5] (0.5)")
+    p.add_argument("--contact", nargs="+", choices=CONTACT_LAWS,
+                   help="contact law: compliant (FEM-calibrated) and/or rigid (rigid tube)")
+    p.add_argument("--residual-tol", type=float, default=None,
+                   help="Newton tolerance on the scaled residual (1e-6)")
+    p.add_argument("--tighten-steps", type=int, default=None,
+                   help="initial load steps of the tightening (40)")
+    p.add_argument("--executor", choices=EXECUTORS, default="process",
+                   help="where cases run: local processes (default), serial (this "
+                   "process), dask (a local cluster, or --scheduler)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes (default: the CPU count, at most the cases)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="dask: address of a running scheduler (tcp://host:8786)")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="run again the cases stored as failed")
+    p.add_argument("--json", metavar="FILE", help="write a summary of every case as JSON")
+    p.add_argument("--device", default=None, help="Warp device (default cpu)")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.set_defaults(handler=run_command)
+
+
+def build_cases(args: argparse.Namespace) -> list:
+    """The sweep's cases from the parsed options (ValueError on bad input)."""
+    from tightknot.sweep.cases import grid
+
+    if args.knot == "closed":
+        bad = [o for o, v in (("--length", args.length), ("--lambda", args.target_lambda),
+                              ("--force", args.pull_force),
+                              ("--lambda-tolerance", args.lambda_tolerance)) if v is not None]
+        if bad:
+            raise ValueError(f"{', '.join(bad)}: for open knots only")
+    else:
+        if args.l0_over_d0 is not None:
+            raise ValueError("--l0-over-d0 is for closed knots (open knots: --length)")
+        if args.target_lambda is None and args.pull_force is None:
+            raise ValueError("an open knot needs its levels: --lambda LAMBDA... or --force "
+                             "F... [N]")
+    base: dict[str, Any] = {"knot": args.knot}
+    for opt in ("target_lambda", "pull_force", "lambda_tolerance", "residual_tol",
+                "tighten_steps"):
+        if getattr(args, opt) is not None:
+            base[opt] = getattr(args, opt)
+    axes = {param: getattr(args, opt) for opt, param in _AXES.items()
+            if getattr(args, opt) is not None}
+    return grid(base, **axes)
+
+
+def short_result(record: dict[str, Any]) -> dict[str, Any]:
+    """A record's headline numbers (no profiles) for the --json summary."""
+    out = {k: record[k] for k in ("id", "params", "status", "failure", "wall_time_s")}
+    res = record.get("result") or {}
+    if "table" in res:
+        out["levels"] = res["table"]
+    else:
+        for k in ("knot_type", "stretch", "L_over_D", "min_gap_over_D0", "min_area_ratio",
+                  "max_pressure_over_E", "kappa_D0_max", "kappa_D0_min", "newton_iterations"):
+            if k in res:
+                out[k] = res[k]
+    return out
+
+
+def _line(record: dict[str, Any], label: str) -> str:
+    head = f"{record['id']}  {label}: {record['status']} ({record['wall_time_s']:.1f} s)"
+    res = record.get("result") or {}
+    if record["status"] != "ok":
+        head += f"\n    {record['failure']}"
+    if "table" in res:
+        for row in res["table"]:
+            lam = "-" if row["lambda_oc"] is None else f"{row['lambda_oc']:.3f}"
+            mark = "" if row["reached"] else "  NOT REACHED"
+            head += (f"\n    {row['kind']} {row['target']:g}: force {row['pull_force_N']:.4g} N,"
+                     f" Lambda_OC {lam}{mark}")
+    elif "L_over_D" in res:
+        head += (f"\n    L/D {res['L_over_D']:.4f}, stretch {res['stretch']:.4f}, min gap/D0 "
+                 f"{res['min_gap_over_D0']:.4f}, kappa D0 max {res['kappa_D0_max']:.3f}")
+    return head
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """Handler of ``tightknot sweep``: 0 every case ok, 1 a case failed, 2 bad input."""
+    from tightknot.atomic import write_json_atomic
+    from tightknot.cli import _writable_file
+    from tightknot.sweep.executors import make_executor
+    from tightknot.sweep.store import Store
+    from tightknot.sweep.sweep import run_sweep
+    from tightknot.warp_setup import resolve_device
+
+    out_json = _writable_file(args.json)
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if args.scheduler is not None and args.executor != "dask":
+        raise ValueError("--scheduler is for --executor dask")
+    cases = build_cases(args)
+    labels = {c.id: c.label() for c in cases}
+    device = resolve_device(args.device)
+    store = Store.open(args.out)  # checks the folder before any work
+    workers = args.workers
+    if args.executor == "process" and workers is None:
+        import os
+
+        workers = min(len(cases), os.cpu_count() or 1)
+    done = [0]
+
+    def progress(record: dict[str, Any]) -> None:
+        done[0] += 1
+        if not args.quiet:
+            print(f"[{done[0]}] {_line(record, labels.get(record['id'], ''))}", flush=True)
+
+    executor = make_executor(args.executor, workers, args.scheduler)
+    try:
+        if not args.quiet:
+            print(f"sweep of {len(cases)} case(s) into {store.folder} ({args.executor})",
+                  flush=True)
+        report = run_sweep(cases, store, executor, retry_failed=args.retry_failed,
+                           on_record=progress, device=device)
+    finally:
+        executor.shutdown()
+    if not args.quiet and report.skipped:
+        print(f"{len(report.skipped)} case(s) already finished in {store.folder} (skipped)")
+    records = report.records()
+    if out_json is not None:
+        write_json_atomic(out_json, {
+            "store": str(store.folder), "cases": [short_result(r) for r in records],
+            "ran": report.ran, "skipped": report.skipped,
+            "failed": report.failed, "wall_time_s": report.wall_time_s})
+    if report.failed:
+        for r in records:
+            if r["id"] in report.failed:
+                print(f"tightknot sweep: case {r['id']} ({labels[r['id']]}) {r['status']}: "
+                      f"{r['failure']}", file=sys.stderr)
+        return EXIT_PHYSICS
+    return EXIT_OK
