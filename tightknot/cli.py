@@ -372,10 +372,12 @@ def build_parser() -> argparse.ArgumentParser:
     from tightknot.benchmarks.commands import register as register_bench
     from tightknot.fem.commands import register as register_fem
     from tightknot.knots.commands import register as register_knots
+    from tightknot.sweep.commands import register as register_sweep
 
     register_knots(sub)
     register_fem(sub)
     register_bench(sub)
+    register_sweep(sub)
     return parser
 
 
