@@ -133,6 +133,8 @@ def newton_solve(
     if not (math.isfinite(energy) and np.isfinite(g).all()):
         return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
     res = problem.residual_norm(g)
+    if not math.isfinite(res):  # e.g. a zero force scale (a rod without stiffness)
+        return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
     history = [res]
     mu = 0.0
     step = math.inf
@@ -190,6 +192,8 @@ def newton_solve(
         if not (math.isfinite(energy) and np.isfinite(g).all()):
             return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
         res = problem.residual_norm(g)
+        if not math.isfinite(res):
+            return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
         history.append(res)
         # Adapt the shift like a trust region (Nocedal & Wright Alg. 4.1 with the
         # Levenberg-Marquardt step): a step that had to be cut, or whose actual decrease is
