@@ -36,6 +36,7 @@ def test_bad_arguments_exit_2() -> None:
     assert exc.value.code == 2
     assert main(["verify", "--case", "no_such_case"]) == 2
     assert main(["verify", "--json", "/no/such/folder/out.json"]) == 2
+    assert main(["demo", "--out", "/no/such/folder/demo"]) == 2
 
 
 def test_verify_json(tmp_path) -> None:

@@ -265,8 +265,11 @@ _DEMO_EXAMPLES = """examples:
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     from tightknot.demo import run_demo
+    from tightknot.run_folder import check_output_dir
 
-    out = Path(args.out)
+    # Checked before the run: the default runs/demo is made with its parents, a given
+    # folder only under an existing parent (a missing parent is more likely a typo).
+    out = check_output_dir(Path(args.out or "runs/demo"), "--out", parents=args.out is None)
     summary = run_demo(out, quiet=args.quiet)
     if not args.quiet:
         print(json.dumps(summary, indent=2))
@@ -355,7 +358,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Run the embedded demo and write its outputs to --out.",
                        epilog=_DEMO_EXAMPLES,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--out", default="runs/demo", help="output folder (created)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output folder (default runs/demo; created)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_demo)
 
