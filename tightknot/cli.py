@@ -160,6 +160,7 @@ def _cmd_tie(args: argparse.Namespace) -> int:
                               ideal - ideal.mean(axis=0) + [0.0, 0.0, -6 * scene.diameter],
                               scene.diameter / 2)
         with bar:
+            bar.update(0.0, "relaxing the start curve")
             run = run_knot(scene, log, cfg.knot, [0], color_by=cfg.color_by,
                            progress=phase_progress(bar, scene.closed), **cfg.tie_options())
     summary = run.summary
