@@ -135,6 +135,17 @@ def summarise(run: KnotRun, ideal: dict | None) -> dict[str, Any]:
     return out
 
 
+def _clean(obj: Any) -> Any:
+    """JSON-ready copy: non-finite floats (no contact: gap inf, Lambda_OC NaN) become None."""
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
 def _fmt(v: Any, nd: int = 3) -> str:
     if v is None:
         return "-"
@@ -223,12 +234,16 @@ def main(argv: list[str] | None = None) -> int:
           f"{rows_ideal['ideal_trefoil_segments']['outer']['median']:.2f} "
           f"[{rows_ideal['ideal_trefoil_segments']['outer']['min']:.2f}, "
           f"{rows_ideal['ideal_trefoil_segments']['outer']['max']:.2f}]")
+    for r in rows:
+        if not r["converged"]:
+            print(f"FAILED {r['scene']} {r['rest_length_mm']:.0f} mm ({r['vertices']} v): "
+                  f"{r['failure']}")
     print(f"total {time.perf_counter() - t0:.1f} s")
     if args.figures:
         draw_figures(runs, Path(args.figures))
     if args.json:
-        write_json_atomic(Path(args.json), {"rows": rows, "ideal": rows_ideal,
-                                            "markdown": table})
+        write_json_atomic(Path(args.json), _clean({"rows": rows, "ideal": rows_ideal,
+                                                   "markdown": table}))
     return 0 if all(r["converged"] for r in rows) else 1
 
 
