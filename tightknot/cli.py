@@ -10,6 +10,7 @@ import argparse
 import dataclasses
 import json
 import sys
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -92,7 +93,8 @@ run folder (--out DIR, default runs/<scene>-<UTC time>):
   centerline.csv  final centerline x,y,z [m]; its header says how to tightknot analyze it
   figures/        the study's figures and the tube coloured by curvature (tube_kappa_D0.png)
   run.rrd         rerun log of every load step: tightknot view DIR/run.rrd
---json/--rrd/--figures send one output elsewhere. Config keys: {keys}.
+--json/--rrd/--figures send one output elsewhere.
+{keys}
 Exit codes: 0 converged, 1 the physics failed (summary and .rrd are still written), 2 bad input.
 """
 
@@ -317,7 +319,8 @@ def build_parser() -> argparse.ArgumentParser:
                        "open trefoil (tightened, then pulled by a force, to an end-to-end "
                        "distance or to a target Lambda_OC) in an elastomer rod, measure it as "
                        "the study did, and write everything into one run folder.",
-                       epilog=_TIE_EXAMPLES.format(keys=", ".join(config_keys())),
+                       epilog=_TIE_EXAMPLES.format(keys=textwrap.fill(
+                           "config keys: " + ", ".join(config_keys()) + ".", 90)),
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("knot", nargs="?", choices=["closed", "open"],
                    help="closed or open trefoil (optional with --config)")
