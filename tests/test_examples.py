@@ -30,3 +30,21 @@ def test_analyze_ideal_example() -> None:
     rep = _load("analyze_ideal").main()
     # The shipped ideal trefoil: L/D = 16.3718 (its README), 6 spikes, double contact.
     assert abs(rep["L_over_D"] - 16.372) < 0.003 and rep["n_curvature_spikes"] == 6
+
+
+def test_readme_python_tour_runs(tmp_path, monkeypatch, capsys) -> None:
+    # The README's first code block is run as written (in a scratch folder: it writes
+    # trefoil.rrd), so the tour a newcomer copies keeps working.
+    import re
+
+    readme = (EXAMPLES.parent / "README.md").read_text()
+    tour = readme.split("## Python tour", 1)[1]
+    code = re.search(r"```python\n(.*?)```", tour, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {"__name__": "readme_tour"})
+    printed = capsys.readouterr().out.split()
+    assert printed[:2] == ["True", "3_1"]
+    # The numbers the README quotes in its comment (stretch 1.0748, kappa*D0 max 0.971), to
+    # the digits it shows.
+    assert round(float(printed[2]), 4) == 1.0748 and round(float(printed[3]), 3) == 0.971
+    assert (tmp_path / "trefoil.rrd").stat().st_size > 0
