@@ -10,7 +10,7 @@ import pytest
 
 from tightknot.cli import build_parser, main
 
-SUBCOMMANDS = ["verify", "bench", "tie", "demo", "view", "analyze", "fem", "calibrate"]
+SUBCOMMANDS = ["verify", "bench", "tie", "demo", "view", "analyze", "fem", "calibrate", "sweep"]
 
 
 @pytest.mark.parametrize("sub", SUBCOMMANDS)
