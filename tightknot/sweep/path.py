@@ -88,7 +88,8 @@ class PathResult:
         levels: one result per level, loosest first.
         tie_wall_time_s: wall-clock time of the tie [s].
         wall_time_s: wall-clock time of the whole path [s].
-        knot_types: knot type after each converged solve of the pull.
+        knot_types: knot type of the tie's steps and of each accepted equilibrium of the
+            pull (a solve that changed it was rejected: see the levels' failures).
         system: the pull system (its state is the last good equilibrium), None if the tie
             failed.
     """
@@ -150,8 +151,9 @@ class _Pull:
                 why = f"Newton {r.reason} at force {f:.4g} N"
         if not why:
             kt = knot_type_of(self.scene, self.system.state.x)
-            self.knot_types.append(kt)
-            if kt != self.scene.knot_type:
+            if kt == self.scene.knot_type:
+                self.knot_types.append(kt)  # the accepted equilibria only
+            else:
                 why = (f"knot type {kt} at force {f:.4g} N (the knot slipped off an end, or "
                        "the rod passed through itself)")
         if why:

@@ -1,0 +1,58 @@
+"""``tightknot sweep``: exit codes, the store and the JSON summary, resuming from the CLI."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tightknot.cli import main
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["open"], "needs its levels"),
+    (["closed", "--length", "0.1"], "--length: for open knots only"),
+    (["open", "--l0-over-d0", "18", "--force", "1"], "--l0-over-d0 is for closed knots"),
+    (["closed", "--workers", "0"], "--workers must be >= 1"),
+    (["closed", "--nodes", "10"], "nodes must be a whole number >= 24"),
+    (["closed", "--poisson", "0.6"], "poisson must be in (-1, 0.5]"),
+    (["open", "--force", "1", "-2"], "pull_force[1] must be > 0 N"),
+    (["closed", "--scheduler", "tcp://x:1"], "--scheduler is for --executor dask"),
+])
+def test_bad_input_exits_2_with_one_line(tmp_path: Path, capsys: pytest.CaptureFixture,
+                                         argv: list[str], words: str) -> None:
+    assert main(["sweep", *argv, "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert words in err and err.count("\n") == 1
+    assert not (tmp_path / "s").exists()  # nothing written before the input is checked
+
+
+def test_a_missing_store_parent_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    assert main(["sweep", "closed", "--out", str(tmp_path / "no" / "s")]) == 2
+    assert "parent folder of the sweep store does not exist" in capsys.readouterr().err
+
+
+def test_a_sweep_runs_resumes_and_reports_a_failed_case(tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture) -> None:
+    out, js = tmp_path / "s", tmp_path / "sweep.json"
+    argv = ["sweep", "closed", "--nodes", "36", "--tighten-steps", "10", "--l0-over-d0",
+            "20", "--executor", "serial", "--out", str(out), "--json", str(js)]
+    assert main(argv) == 0
+    first = json.loads(js.read_text())
+    (case,) = first["cases"]
+    assert case["status"] == "ok" and case["knot_type"] == "3_1"
+    assert first["ran"] == [case["id"]] and first["skipped"] == []
+    assert json.loads((out / "index.json").read_text())["counts"]["ok"] == 1
+    assert "L/D" in capsys.readouterr().out
+    # The same command again: nothing to run, the same result.
+    assert main(argv) == 0
+    again = json.loads(js.read_text())
+    assert again["ran"] == [] and again["skipped"] == [case["id"]]
+    assert again["cases"][0]["L_over_D"] == case["L_over_D"]
+    # A second axis value whose scene refuses the mesh (36 vertices are too few for a
+    # knot this long: the scene's own edge-length check) is a failed case: exit 1, the
+    # reason on stderr, the finished case still skipped.
+    assert main([*argv[:6], "--l0-over-d0", "20", "40", *argv[8:]]) == 1
+    err = capsys.readouterr().err
+    assert "error: ValueError" in err and "nodes" in err
+    final = json.loads(js.read_text())
+    assert final["skipped"] == [case["id"]] and len(final["failed"]) == 1
