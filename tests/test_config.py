@@ -71,6 +71,10 @@ def test_bad_files(tmp_path) -> None:
     listed.write_text("[1, 2]")
     with pytest.raises(ValueError, match="mapping"):
         load_config(listed)
+    binary = tmp_path / "binary.json"
+    binary.write_bytes(b"\xff\xfe{\x00")
+    with pytest.raises(ValueError, match=r"binary.json: not a UTF-8 text file"):
+        load_config(binary)
     typo = tmp_path / "typo.toml"
     typo.write_text('knot = "closed"\nnode = 60\n')
     with pytest.raises(ValueError, match=r"typo.toml: unknown key\(s\) 'node'"):

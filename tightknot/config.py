@@ -196,6 +196,9 @@ def load_config(path: str | os.PathLike[str]) -> TieConfig:
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"--config {p}: not a UTF-8 text file ({exc.reason} at byte "
+                         f"{exc.start})") from None
     except OSError as exc:
         raise ValueError(f"--config {p}: cannot read ({exc.strerror})") from None
     if p.suffix.lower() == ".toml":
