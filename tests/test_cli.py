@@ -240,9 +240,15 @@ def test_tie_flags_override_the_config_file(tmp_path) -> None:
 
 
 def test_tie_default_run_folder(tmp_path, monkeypatch) -> None:
-    from tightknot.run_folder import default_run_dir
+    from tightknot.run_folder import default_run_dir, plan_outputs
 
     monkeypatch.chdir(tmp_path)
+    # A fresh checkout has no runs/: a folder under it is fine (made on demand), a folder
+    # under another missing parent is refused.
+    assert plan_outputs("closed_trefoil", "runs/a/b").folder == Path("runs/a/b")
+    with pytest.raises(ValueError, match="parent folder does not exist"):
+        plan_outputs("closed_trefoil", "other/a")
+    assert not Path("runs").exists()  # checking makes nothing
     first = default_run_dir("closed_trefoil")
     assert first.parent == Path("runs") and first.name.startswith("closed_trefoil-")
     first.mkdir(parents=True)

@@ -268,11 +268,12 @@ _DEMO_EXAMPLES = """examples:
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     from tightknot.demo import run_demo
-    from tightknot.run_folder import check_output_dir
+    from tightknot.run_folder import check_output_dir, in_runs_tree
 
-    # Checked before the run: the default runs/demo is made with its parents, a given
-    # folder only under an existing parent (a missing parent is more likely a typo).
-    out = check_output_dir(Path(args.out or "runs/demo"), "--out", parents=args.out is None)
+    # Checked before the run: a folder under runs/ (the default runs/demo) is made with its
+    # parents, any other only under an existing parent (a missing parent is likely a typo).
+    out = Path(args.out)
+    check_output_dir(out, "--out", parents=in_runs_tree(out))
     summary = run_demo(out, quiet=args.quiet)
     if not args.quiet:
         print(json.dumps(summary, indent=2))
@@ -350,7 +351,8 @@ def build_parser() -> argparse.ArgumentParser:
                    choices=list(COLOR_FIELDS) + list(COLOR_ALIASES),
                    help=f"colour of the rod tube in the .rrd: {', '.join(COLOR_FIELDS)} "
                    "(kappa_D0; contact_width = contact_width_fraction)")
-    p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>)")
+    p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>; "
+                   "made with its parents under runs/, elsewhere its parent must exist)")
     p.add_argument("--json", metavar="FILE", help="write the summary here instead")
     p.add_argument("--figures", metavar="DIR", help="write the figures here instead")
     p.add_argument("--rrd", metavar="FILE", help="write the rerun log here instead")
@@ -362,7 +364,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Run the embedded demo and write its outputs to --out.",
                        epilog=_DEMO_EXAMPLES,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--out", default=None, metavar="DIR",
+    p.add_argument("--out", default="runs/demo", metavar="DIR",
                    help="output folder (default runs/demo; created)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_demo)

@@ -29,8 +29,18 @@ RUN_RRD = "run.rrd"
 FIGURES_DIR = "figures"
 
 
+#: The tree of run folders in the working folder, created on demand.
+RUNS_ROOT = Path("runs")
+
+
+def in_runs_tree(path: Path) -> bool:
+    """True for a relative path under ``runs/``: its missing parents are made on demand (a
+    fresh checkout has no ``runs/`` yet); any other new folder needs an existing parent."""
+    return not path.is_absolute() and path.parts[:1] == RUNS_ROOT.parts
+
+
 def default_run_dir(scene_name: str, now: _dt.datetime | None = None,
-                    root: Path = Path("runs")) -> Path:
+                    root: Path = RUNS_ROOT) -> Path:
     """``runs/<scene>-<YYYYmmdd-HHMMSS>`` (UTC); ``-2``, ``-3``... when that one exists."""
     stamp = (now or _dt.datetime.now(_dt.timezone.utc)).strftime("%Y%m%d-%H%M%S")
     base = root / f"{scene_name}-{stamp}"
@@ -101,11 +111,12 @@ def plan_outputs(scene_name: str, out: str | None = None, json: str | None = Non
                  rrd: str | None = None, figures: str | None = None) -> RunOutputs:
     """Resolve and check every output path of a run before it starts (ValueError if bad).
 
-    ``out`` None: :func:`default_run_dir` (created with its parents); a given ``out`` may be
-    new but its parent must exist (a missing parent is a typo more often than a wish).
+    ``out`` None: :func:`default_run_dir`. A folder under ``runs/`` is made with its parents;
+    any other may be new but its parent must exist (a missing parent is a typo more often
+    than a wish).
     """
     folder = Path(out) if out is not None else default_run_dir(scene_name)
-    check_output_dir(folder, "--out", parents=out is None)
+    check_output_dir(folder, "--out", parents=in_runs_tree(folder))
     summary = Path(json) if json is not None else folder / SUMMARY_JSON
     rrd_path = Path(rrd) if rrd is not None else folder / RUN_RRD
     figs = Path(figures) if figures is not None else folder / FIGURES_DIR
