@@ -199,7 +199,7 @@ def open_force_path(final_force: float, nodes: int = 150, pull_steps: int = 20) 
         lam = lambda_oc(x, scene.diameter, vertex_radii(scene, x, system.rest)[1])
         dmin, _, _ = scene.contact.min_distance(x)
         path.append({"force_N": f, "lambda_oc": lam if math.isfinite(lam) else None,
-                     "min_gap_over_D0": dmin / scene.diameter,
+                     "min_gap_over_D0": dmin / scene.diameter if math.isfinite(dmin) else None,
                      "stretch": _length(x, False) / scene.rest_length})
 
     scene = open_trefoil(0.185, D0, nodes)

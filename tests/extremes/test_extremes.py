@@ -194,7 +194,10 @@ def test_vertex_count_medium(nodes: int) -> None:
 
 
 @extremes
-@pytest.mark.parametrize("nodes", [10_000, 100_000])
+@pytest.mark.parametrize("nodes", [10_000, pytest.param(100_000, marks=pytest.mark.xfail(
+    strict=True, raises=MemoryError, reason="bug (issue 8 report): the contact layer "
+    "allocates 144 Hessian doubles per candidate pair; a tight trefoil of 1e5 vertices has "
+    "~2e8 candidates (1.9e6 at 1e4), so std::bad_alloc escapes instead of a clear error"))])
 def test_vertex_count_huge_bounded(nodes: int) -> None:
     # A full tie is ~500 Newton iterations; at 1e5 vertices one costs ~6 s here, so the
     # relaxation gets a budget of 3: the run must end cleanly (no NaN, a message).
