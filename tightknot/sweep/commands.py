@@ -190,8 +190,12 @@ def run_command(args: argparse.Namespace) -> int:
                   flush=True)
         report = run_sweep(cases, store, executor, retry_failed=args.retry_failed,
                            on_record=progress, device=device)
-    finally:
-        executor.shutdown()
+    except BaseException:
+        # Interrupted (Ctrl-C) or broken: the finished cases are stored; do not wait for
+        # the running ones (they are run again by the next call).
+        executor.shutdown(wait=False, cancel_futures=True)
+        raise
+    executor.shutdown()
     if not args.quiet and report.skipped:
         print(f"{len(report.skipped)} case(s) already finished in {store.folder} (skipped)")
     records = report.records()

@@ -200,13 +200,17 @@ class _Pull:
         if contact.min_distance(xp)[0] >= 0.9 * contact.min_distance(x1)[0]:
             self.system.state.x = xp
 
-    def move_to(self, target: float, max_failures: int = 3) -> str:
+    def move_to(self, target: float, max_failures: int = 3, down_ratio: float = 1.15) -> str:
         """Reach force ``target`` [N] from the current equilibrium: one step when it
         converges, else geometric sub-steps (the log-force step halved after a failure,
         doubled after a success), giving up after ``max_failures`` failed solves (a failed
         solve costs its proximal budget; past a few, the knot is slipping: no equilibrium
-        near this path). "" on success, else the last reason."""
+        near this path). A falling force moves by at most a factor ``down_ratio`` per step
+        (tie_to_lambda's step): a sudden drop of the dead load lets the knot spring open
+        and slip off (tie() explains). "" on success, else the last reason."""
         step = abs(math.log(target / self.force))
+        if target < self.force:
+            step = min(step, math.log(down_ratio))
         failures = 0
         while self.force != target:
             remaining = math.log(target / self.force)
@@ -219,6 +223,8 @@ class _Pull:
             why = self.solve(f)
             if not why:
                 step = 2.0 * taken
+                if target < self.force:
+                    step = min(step, math.log(down_ratio))
                 continue
             failures += 1
             if failures >= max_failures:

@@ -10,7 +10,8 @@ every finished case. A crash at any moment leaves complete files only (tightknot
 at worst a case file whose index entry is missing or still "pending", which
 :meth:`Store.open` repairs by reading the case files back. So a sweep that is interrupted
 and started again skips every finished case and loses nothing but the cases that were
-running.
+running. One sweep at a time writes a store (two writing the same folder at once would
+race on the index; the case files stay whole, and the next :meth:`Store.open` repairs it).
 """
 
 from __future__ import annotations

@@ -86,7 +86,9 @@ def run_sweep(
         cases: the sweep (see :func:`tightknot.sweep.cases.grid`); duplicates run once.
         store: a :class:`Store` or its folder (created if missing; its parent must exist).
         executor: where the cases run (default: a process pool of up to the CPU count
-            workers, shut down at the end); an executor passed in stays open.
+            workers, shut down at the end; its workers are spawned, so a script calling
+            this needs the usual ``if __name__ == "__main__":`` guard); an executor passed
+            in stays open.
         retry_failed: run again the cases stored as failed or error.
         on_record: called with each record after it is stored (progress output); an
             exception there stops the sweep (the stored records stay).
