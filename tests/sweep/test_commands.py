@@ -26,6 +26,20 @@ def test_bad_input_exits_2_with_one_line(tmp_path: Path, capsys: pytest.CaptureF
     assert not (tmp_path / "s").exists()  # nothing written before the input is checked
 
 
+def test_every_multi_valued_option_is_an_axis() -> None:
+    from tightknot.cli import build_parser
+    from tightknot.sweep.commands import build_cases
+
+    args = build_parser().parse_args([
+        "sweep", "open", "--out", "x", "--length", "0.185", "0.16", "--nodes", "150", "300",
+        "--twist", "on", "off", "--contact", "compliant", "rigid", "--lambda", "13", "14"])
+    cases = build_cases(args)
+    assert len(cases) == 16 and len({c.id for c in cases}) == 16
+    # The levels stay one path per case, loosest first.
+    assert all(c.params["target_lambda"] == [14.0, 13.0] for c in cases)
+    assert {c.params["twist"] for c in cases} == {True, False}
+
+
 def test_a_missing_store_parent_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     assert main(["sweep", "closed", "--out", str(tmp_path / "no" / "s")]) == 2
     assert "parent folder of the sweep store does not exist" in capsys.readouterr().err

@@ -77,6 +77,9 @@ def register(subparsers: Any) -> None:
                    help="Poisson ratio in (-1, 0.5] (0.5)")
     p.add_argument("--contact", nargs="+", choices=CONTACT_LAWS,
                    help="contact law: compliant (FEM-calibrated) and/or rigid (rigid tube)")
+    p.add_argument("--twist", nargs="+", choices=["on", "off"],
+                   help="twist dofs (default on for closed, off for open knots: an isotropic "
+                   "rod with twist-free ends relaxes its twist to zero)")
     p.add_argument("--residual-tol", type=float, default=None,
                    help="Newton tolerance on the scaled residual (1e-6)")
     p.add_argument("--tighten-steps", type=int, default=None,
@@ -119,6 +122,8 @@ def build_cases(args: argparse.Namespace) -> list:
             base[opt] = getattr(args, opt)
     axes = {param: getattr(args, opt) for opt, param in _AXES.items()
             if getattr(args, opt) is not None}
+    if args.twist is not None:
+        axes["twist"] = [v == "on" for v in args.twist]
     return grid(base, **axes)
 
 
