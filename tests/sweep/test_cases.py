@@ -68,3 +68,31 @@ def test_a_grid_axis_cannot_repeat_a_fixed_parameter() -> None:
         grid({"knot": "closed", "nodes": 60}, nodes=[60, 80])
     with pytest.raises(ValueError, match="non-empty list"):
         grid({"knot": "closed"}, nodes=[])
+
+
+def test_knot_types_have_their_own_default_lengths() -> None:
+    assert Case.of({"knot": "closed"}).params["l0_over_d0"] == 16.37
+    assert Case.of({"knot": "closed", "knot_type": "4_1"}).params["l0_over_d0"] == 22.1
+    assert Case.of({"knot": "open", "knot_type": "4_1", "pull_force": [2]}).params["length"] \
+        == 0.30
+    with pytest.raises(ValueError, match="knot_type must be one of"):
+        Case.of({"knot": "closed", "knot_type": "5_1"})
+
+
+def test_a_case_builds_the_scene_it_names() -> None:
+    # Scenes build without solving (fast): the case's parameters reach the scene.
+    from tightknot.sweep.execute import build_scene
+
+    scene = build_scene(Case.of({"knot": "closed", "knot_type": "4_1", "nodes": 120,
+                                 "contact": "rigid", "poisson": 0.3,
+                                 "youngs_modulus": 2e6}).params)
+    assert scene.knot_type == "4_1" and scene.closed
+    assert scene.model.vertex_count == 120
+    assert scene.contact.law.rigid
+    assert scene.model.rods[0].material.poisson_ratio == 0.3
+    assert scene.model.rods[0].material.youngs_modulus == 2e6
+    assert abs(scene.rest_length / scene.diameter - 22.1) < 1e-12
+    scene = build_scene(Case.of({"knot": "open", "nodes": 100, "length": 0.16,
+                                 "pull_force": [3.0]}).params)
+    assert scene.knot_type == "3_1" and not scene.closed and not scene.contact.law.rigid
+    assert scene.rest_length == 0.16 and not scene.model.twist

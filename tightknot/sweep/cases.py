@@ -9,6 +9,8 @@ order or spelling in which it was asked for; the store uses the id to skip finis
 Parameters (SI units):
 
 * ``knot``: "closed" (the study's closed trefoil) or "open" (overhand knot, pulled).
+* ``knot_type``: "3_1" (trefoil, the study's) or "4_1" (figure-eight; its scenes'
+  default lengths: L0/D0 = 22.1 closed, L0 = 0.30 m open).
 * ``nodes``: vertices (>= 24 closed, >= 40 open; default 200 closed, 300 open).
 * ``diameter`` D0 [m] (8.5e-3), ``youngs_modulus`` E [Pa] (1.25e6), ``poisson`` nu
   (0.5, in (-1, 0.5]), ``density`` [kg/m^3] (1160; only the proximal fallback uses it).
@@ -51,9 +53,24 @@ _COMMON_DEFAULTS: dict[str, Any] = {
     "tighten_steps": 40,
 }
 _DEFAULTS: dict[str, dict[str, Any]] = {
-    "closed": {"nodes": 200, "twist": True, "l0_over_d0": 16.37},
-    "open": {"nodes": 300, "twist": False, "length": 0.185, "lambda_tolerance": 0.1},
+    "closed": {"knot_type": "3_1", "nodes": 200, "twist": True, "l0_over_d0": None},
+    "open": {"knot_type": "3_1", "nodes": 300, "twist": False, "length": None,
+             "lambda_tolerance": 0.1},
 }
+#: Knot types with a scene (tightknot.knots.scenes), and the default length of each: the
+#: study's trefoils (L0/D0 = 16.37; L0 = 185 mm), the figure-eight scenes' own defaults.
+KNOT_TYPES = ("3_1", "4_1")
+_LENGTH_DEFAULTS = {("closed", "3_1"): 16.37, ("closed", "4_1"): 22.1,
+                    ("open", "3_1"): 0.185, ("open", "4_1"): 0.30}
+_LENGTH_KEY = {"closed": "l0_over_d0", "open": "length"}
+
+
+def defaults(knot: str, knot_type: str = "3_1") -> dict[str, Any]:
+    """Every parameter's default for a ``knot`` ("closed"/"open") of ``knot_type``."""
+    out = {**_COMMON_DEFAULTS, **_DEFAULTS[knot]}
+    out["knot_type"] = knot_type
+    out[_LENGTH_KEY[knot]] = _LENGTH_DEFAULTS[(knot, knot_type)]
+    return out
 _MIN_NODES = {"closed": 24, "open": 40}
 
 
@@ -101,8 +118,11 @@ def canonical(params: Mapping[str, Any]) -> dict[str, Any]:
     if unknown:
         raise ValueError(f"unknown parameter(s) {unknown} for a {knot} knot; valid: "
                          f"{sorted(allowed)}")
+    knot_type = p.get("knot_type", "3_1")
+    if knot_type not in KNOT_TYPES:
+        raise ValueError(f"knot_type must be one of {KNOT_TYPES}, got {knot_type!r}")
     out: dict[str, Any] = {"knot": knot}
-    for key, default in {**_COMMON_DEFAULTS, **_DEFAULTS[knot]}.items():
+    for key, default in defaults(knot, knot_type).items():
         out[key] = p.get(key, default)
     nodes = out["nodes"]
     if isinstance(nodes, bool) or not isinstance(nodes, int | float) or nodes != int(nodes) \
@@ -189,10 +209,12 @@ class Case:
 
     def label(self) -> str:
         """Short human label: the knot and the parameters that differ from the defaults."""
-        defaults = {**_COMMON_DEFAULTS, **_DEFAULTS[self.params["knot"]]}
+        base = defaults(self.params["knot"], self.params["knot_type"])
         parts = [self.params["knot"]]
+        if self.params["knot_type"] != "3_1":
+            parts.append(self.params["knot_type"])
         for k, v in self.params.items():
-            if k == "knot" or (k in defaults and defaults[k] == v):
+            if k in ("knot", "knot_type") or (k in base and base[k] == v):
                 continue
             if isinstance(v, list):
                 parts.append(f"{k}={len(v)} levels")

@@ -38,7 +38,7 @@ record (the knot summary of 'tightknot tie'; for an open knot one entry per leve
 _AXES = {
     "nodes": "nodes", "diameter": "diameter", "youngs_modulus": "youngs_modulus",
     "poisson": "poisson", "contact": "contact", "l0_over_d0": "l0_over_d0",
-    "length": "length",
+    "length": "length", "knot_type": "knot_type",
 }
 
 
@@ -55,12 +55,14 @@ def register(subparsers: Any) -> None:
         "started again skips the finished cases.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("knot", choices=["closed", "open"], help="closed or open trefoil")
+    p.add_argument("--knot-type", nargs="+", choices=["3_1", "4_1"],
+                   help="trefoil 3_1 (the study's, default) and/or figure-eight 4_1")
     p.add_argument("--out", required=True, metavar="DIR",
                    help="the store folder (created; its parent must exist)")
     p.add_argument("--l0-over-d0", type=float, nargs="+", metavar="R",
-                   help="closed: L0/D0 values (16.37)")
+                   help="closed: L0/D0 values (16.37; figure-eight 22.1)")
     p.add_argument("--length", type=float, nargs="+", metavar="L0",
-                   help="open: rest lengths L0 [m] (0.185)")
+                   help="open: rest lengths L0 [m] (0.185; figure-eight 0.30)")
     levels = p.add_mutually_exclusive_group()
     levels.add_argument("--lambda", dest="target_lambda", type=float, nargs="+",
                         metavar="LAMBDA", help="open: target knot lengths Lambda_OC, "

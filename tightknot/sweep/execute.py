@@ -28,19 +28,15 @@ TIMING_KEYS = ("wall_time_s", "cumulative_wall_time_s", "tie_wall_time_s", "host
 
 def build_scene(params: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     """The :class:`~tightknot.knots.scenes.KnotScene` of canonical case ``params``."""
-    from tightknot.knots.scenes import closed_trefoil, open_trefoil
-    from tightknot.rods.contact_law import RadialComplianceLaw
+    from tightknot.knots import scenes
     from tightknot.rods.material import Material
 
     material = Material(params["youngs_modulus"], params["poisson"], params["density"])
-    law = RadialComplianceLaw.from_json()
-    if params["contact"] == "rigid":
-        law = law.rigid_tube()
-    if params["knot"] == "closed":
-        return closed_trefoil(params["l0_over_d0"], params["diameter"], params["nodes"],
-                              material, law=law, twist=params["twist"], device=device)
-    return open_trefoil(params["length"], params["diameter"], params["nodes"], material,
-                        law=law, twist=params["twist"], device=device)
+    name = {"3_1": "trefoil", "4_1": "figure_eight"}[params["knot_type"]]
+    make = getattr(scenes, f"{params['knot']}_{name}")
+    length = params["l0_over_d0"] if params["knot"] == "closed" else params["length"]
+    return make(length, params["diameter"], params["nodes"], material, twist=params["twist"],
+                contact=params["contact"], device=device)
 
 
 def solve_case(case: Case, device: str = "cpu") -> dict[str, Any]:
@@ -91,7 +87,7 @@ def run_case(params: Mapping[str, Any], device: str = "cpu") -> dict[str, Any]:
         out = solve_case(case, device)
     except Exception as err:  # noqa: BLE001 (one case's crash must not stop the sweep)
         tb = traceback.format_exception_only(type(err), err)[-1].strip()
-        out = {"status": ERROR, "failure": f"error: {tb}", "result": None}
+        out = {"status": ERROR, "failure": tb, "result": None}
     return {"id": case.id, "params": case.params, **out,
             "wall_time_s": time.perf_counter() - start,
             "host": platform.node(), "pid": os.getpid()}
