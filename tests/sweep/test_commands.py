@@ -70,3 +70,16 @@ def test_a_sweep_runs_resumes_and_reports_a_failed_case(tmp_path: Path,
     assert "error: ValueError" in err and "nodes" in err
     final = json.loads(js.read_text())
     assert final["skipped"] == [case["id"]] and len(final["failed"]) == 1
+
+
+def test_without_dask_the_dask_executor_says_how_to_install_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch) -> None:
+    import sys
+
+    # A None entry in sys.modules makes "import distributed" raise ImportError, as on an
+    # installation without the extra.
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    argv = ["sweep", "closed", "--executor", "dask", "--out", str(tmp_path / "s")]
+    assert main(argv) == 2
+    assert "pip install tightknot[distributed]" in capsys.readouterr().err
+    assert not (tmp_path / "s").exists()

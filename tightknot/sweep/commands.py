@@ -177,7 +177,6 @@ def run_command(args: argparse.Namespace) -> int:
     cases = build_cases(args)
     labels = {c.id: c.label() for c in cases}
     device = resolve_device(args.device)
-    store = Store.open(args.out)  # checks the folder before any work
     workers = args.workers
     if args.executor == "process" and workers is None:
         import os
@@ -190,8 +189,11 @@ def run_command(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(f"[{done[0]}] {_line(record, labels.get(record['id'], ''))}", flush=True)
 
+    # The executor first (a missing Dask is bad input), then the store (checks its folder),
+    # both before any case runs.
     executor = make_executor(args.executor, workers, args.scheduler)
     try:
+        store = Store.open(args.out)
         if not args.quiet:
             print(f"sweep of {len(cases)} case(s) into {store.folder} ({args.executor})",
                   flush=True)
