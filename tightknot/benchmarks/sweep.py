@@ -42,9 +42,12 @@ def _warm_up() -> float:
 
 def run(levels: int = DEFAULT_LEVELS, nodes: int = DEFAULT_NODES,
         length: float = DEFAULT_LENGTH, loosest: float = DEFAULT_LOOSEST,
-        tightest: float = DEFAULT_TIGHTEST, force: bool = False) -> dict[str, Any]:
+        tightest: float = DEFAULT_TIGHTEST, force: bool = False,
+        with_tie_to_lambda: bool = False) -> dict[str, Any]:
     """Time the sweep and its tightest level alone; ``force`` sweeps pulling forces [N]
-    from ``loosest`` to ``tightest`` (geometric) instead of Lambda_OC (linear)."""
+    from ``loosest`` to ``tightest`` (geometric) instead of Lambda_OC (linear);
+    ``with_tie_to_lambda`` also times the knots package's own driver to the tightest
+    Lambda_OC (:func:`tightknot.knots.tie.tie_to_lambda`)."""
     from tightknot.sweep import Case, run_case, run_sweep
     from tightknot.sweep.executors import SerialExecutor
 
@@ -65,6 +68,17 @@ def run(levels: int = DEFAULT_LEVELS, nodes: int = DEFAULT_NODES,
     t0, c0 = time.perf_counter(), time.process_time()
     alone = run_case(tight.params)
     t_alone, c_alone = time.perf_counter() - t0, time.process_time() - c0
+    extra: dict[str, Any] = {}
+    if with_tie_to_lambda and not force:
+        from tightknot.knots.tie import tie_to_lambda
+        from tightknot.sweep.execute import build_scene
+
+        scene = build_scene(tight.params)
+        t0 = time.perf_counter()
+        ttl = tie_to_lambda(scene, case.levels[-1])
+        extra = {"tie_to_lambda_s": time.perf_counter() - t0,
+                 "tie_to_lambda_converged": ttl.converged,
+                 "tie_to_lambda_force_N": ttl.pull_force_N}
     res = record.get("result") or {}
     rows = [{k: lv[k] for k in ("target", "reached", "pull_force_N", "lambda_oc",
                                 "newton_iterations", "solves", "wall_time_s", "failure")}
@@ -91,6 +105,7 @@ def run(levels: int = DEFAULT_LEVELS, nodes: int = DEFAULT_NODES,
         # jobs the wall time grows with the load, this much less.
         "cpu_time_s": c_sweep,
         "tightest_level_alone_cpu_s": c_alone,
+        **extra,
         "warmup_s": warm,
         "cpu_count": os.cpu_count(),
         "load_average_1min": os.getloadavg()[0],
@@ -127,6 +142,8 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
                    help="tightest level: Lambda_OC (10.25), or force [N] with --force")
     p.add_argument("--force", action="store_true",
                    help="levels are pulling forces (geometric), not knot lengths")
+    p.add_argument("--with-tie-to-lambda", action="store_true",
+                   help="also time tightknot.knots.tie.tie_to_lambda to the tightest level")
     p.set_defaults(handler=_command)
 
 
@@ -139,7 +156,8 @@ def _command(args) -> int:  # noqa: ANN001
         raise ValueError("--force needs --loosest F1 and --tightest F2 [N]")
     loosest = DEFAULT_LOOSEST if args.loosest is None else args.loosest
     tightest = DEFAULT_TIGHTEST if args.tightest is None else args.tightest
-    result = run(args.levels, args.nodes, args.length, loosest, tightest, args.force)
+    result = run(args.levels, args.nodes, args.length, loosest, tightest, args.force,
+                 args.with_tie_to_lambda)
     for r in result["per_level"]:
         lam = "-" if r["lambda_oc"] is None else f"{r['lambda_oc']:.3f}"
         print(f"  level {r['target']:8.4g}: {'ok ' if r['reached'] else 'NOT'} force "
@@ -154,6 +172,9 @@ def _command(args) -> int:  # noqa: ANN001
           f"{result['ratio_sweep_over_tightest_alone']:.2f}; {result['levels_reached']}/"
           f"{result['levels']} levels reached; load average {result['load_average_1min']:.1f}"
           f" on {result['cpu_count']} CPUs")
+    if "tie_to_lambda_s" in result:
+        print(f"tie_to_lambda to the tightest level: {result['tie_to_lambda_s']:.2f} s "
+              f"(force {result['tie_to_lambda_force_N']:.4g} N)")
     if result["failure"]:
         print(f"  failure: {result['failure']}")
     if out is not None:
