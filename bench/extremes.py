@@ -105,11 +105,12 @@ def _renamed(out: C.Outcome, suffix: str) -> C.Outcome:
 
 #: The limiting quantity shown in the table, per group (the JSON has them all).
 _SHOW = {
-    "slenderness": ("stretch", "min_gap_over_D0"),
-    "closed tightness": ("stretch", "min_gap_over_D0", "kappa_D0_max"),
-    "open pull": ("lambda_oc_min_on_path", "pull_force_N", "min_gap_over_D0"),
+    "slenderness": ("stretch", "min_gap_over_D0", "min_vertex_gap_over_D0"),
+    "closed tightness": ("stretch", "min_gap_over_D0", "min_vertex_gap_over_D0",
+                         "kappa_D0_max"),
+    "open pull": ("lambda_oc_min_on_path", "min_gap_over_D0", "min_vertex_gap_over_D0"),
     "material": ("stretch", "kappa_D0_max", "min_radius_over_r0"),
-    "vertex count": ("stretch", "min_gap_over_D0"),
+    "vertex count": ("stretch", "min_gap_over_D0", "min_vertex_gap_over_D0"),
     "dynamics": ("energy_growth_over_ke0", "ke_last_over_ke0"),
     "float32": ("residual_float64", "residual_positions_rounded_to_float32"),
 }
