@@ -92,6 +92,9 @@ def build_batch(scenes: list[KnotScene]) -> BatchModel:
         if not sc.closed:
             raise ValueError(f"scenes[{k}] is open ({sc.name}): the batch ties closed knots "
                              "only (an open knot's moving end needs its own load path)")
+        if sc.contact is None:
+            raise ValueError(f"scenes[{k}] has contact='off': tying a knot needs a contact "
+                             "layer")
         if len(sc.model.rods) != 1:
             raise ValueError(f"scenes[{k}] has {len(sc.model.rods)} rods; one rod per scene")
     first = scenes[0]

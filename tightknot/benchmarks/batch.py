@@ -1,0 +1,150 @@
+"""Batched tying against one-after-another: ``tightknot bench batch``.
+
+The cases are a sweep of closed trefoils over L0/D0 (the small cases a sweep runs), each
+tied by :func:`tightknot.knots.tie.tie` one after another, and all together by
+:func:`tightknot.knots.batch.tie_batch` (one model, one Newton loop). Both are timed in the
+same run; the batched result is checked against the sequential one (largest vertex
+difference over D0). Where the time goes is measured too: the cost of one Newton
+iteration's parts (evaluation with Hessian, factorization and solve) per rod, for one rod
+alone and inside the batch, at the tied state.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from tightknot.knots.batch import tie_batch
+from tightknot.knots.scenes import closed_trefoil
+from tightknot.knots.tie import tie
+from tightknot.solvers.linear import factorize
+from tightknot.solvers.system import RodSystem
+
+#: The issue's target: 64 trefoils of 100 vertices batched >= 5x faster than sequential.
+TARGET_SPEEDUP = 5.0
+
+
+def _iteration_parts(system: RodSystem, repeats: int = 3) -> dict[str, float]:
+    """Median times [s] of one evaluation with Hessian and one factorization + solve."""
+    u = system.free_vector()
+    te, tf = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        _, g, h = system.evaluate(u, True, True)
+        t1 = time.perf_counter()
+        factorize(h).solve(-g)
+        t2 = time.perf_counter()
+        te.append(t1 - t0)
+        tf.append(t2 - t1)
+    return {"evaluate_s": float(np.median(te)), "factorize_solve_s": float(np.median(tf))}
+
+
+def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.0, 20.0),
+        sequential_rods: int | None = None, residual_tol: float = 1e-6) -> dict:
+    """Tie ``rods`` closed trefoils of ``nodes`` vertices (L0/D0 evenly over the range)
+    batched and one by one; ``sequential_rods`` < rods ties only that many evenly chosen
+    cases one by one and extrapolates the sequential time (said so in the result)."""
+    if int(rods) != rods or rods < 1:
+        raise ValueError(f"rods must be a whole number >= 1, got {rods!r}")
+    seq_n = rods if sequential_rods is None else int(sequential_rods)
+    if not (1 <= seq_n <= rods):
+        raise ValueError(f"sequential_rods must be in [1, rods={rods}], got {sequential_rods!r}")
+    lo, hi = (float(v) for v in l0_over_d0)
+    if not (math.isfinite(lo) and math.isfinite(hi) and 10.0 <= lo <= hi):
+        raise ValueError(f"l0_over_d0 must be a range LO <= HI with LO >= 10, got {l0_over_d0}")
+    ratios = np.linspace(lo, hi, rods)
+    scenes = [closed_trefoil(l0_over_d0=float(r), nodes=nodes) for r in ratios]
+    t0 = time.perf_counter()
+    batch = tie_batch(scenes, residual_tol=residual_tol)
+    tb = time.perf_counter() - t0
+    if not batch.converged:
+        raise RuntimeError(f"batched tie failed: {batch.failure}")
+
+    pick = np.unique(np.round(np.linspace(0, rods - 1, seq_n)).astype(int))
+    ts = 0.0
+    seq_iters = 0
+    diff = 0.0
+    last = None
+    for k in pick:
+        scene = closed_trefoil(l0_over_d0=float(ratios[k]), nodes=nodes)
+        t0 = time.perf_counter()
+        single = tie(scene, residual_tol=residual_tol)
+        ts += time.perf_counter() - t0
+        if not single.converged:
+            raise RuntimeError(f"sequential tie of case {k} failed: {single.failure}")
+        seq_iters += single.newton_iterations
+        diff = max(diff, float(np.abs(single.system.state.x - batch.positions[k]).max())
+                   / scene.diameter)
+        last = single
+    extrapolated = len(pick) < rods
+    sequential_s = ts * rods / len(pick)
+    one = _iteration_parts(last.system)
+    many = _iteration_parts(batch.system)
+    per_rod = {k: v / rods for k, v in many.items()}
+    return {
+        "rods": rods,
+        "vertices": nodes,
+        "l0_over_d0": [lo, hi],
+        "batched_s": tb,
+        "sequential_s": sequential_s,
+        "speedup": sequential_s / tb,
+        "sequential_extrapolated": extrapolated,
+        "sequential_measured_rods": int(len(pick)),
+        "batched_newton_iterations": batch.newton_iterations,
+        "sequential_newton_iterations": int(round(seq_iters * rods / len(pick))),
+        "max_position_diff_over_D0": diff,
+        "iteration_cost": {"single_rod": one, "batched_per_rod": per_rod},
+        "target_speedup_min": TARGET_SPEEDUP,
+    }
+
+
+# -- command line (``tightknot bench batch``) ------------------------------------------------
+_EXAMPLES = """examples:
+  tightknot bench batch --json batch.json
+  tightknot bench batch --rods 8 --nodes 60
+  tightknot bench batch --sequential-rods 8   # extrapolates the sequential time (said so)
+"""
+
+
+def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers type)
+    """Add ``tightknot bench batch``."""
+    import argparse
+
+    p = subparsers.add_parser(
+        "batch", help="many closed trefoils tied in one model vs one after another",
+        description="Tie ROD closed trefoils (L0/D0 swept over a range) in one model and one "
+        "Newton loop, and one after another; report both times and their ratio.",
+        epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--json", metavar="FILE", help="write the result as JSON")
+    p.add_argument("--rods", type=int, default=64, help="number of knots (default 64)")
+    p.add_argument("--nodes", type=int, default=100, help="vertices per knot (default 100)")
+    p.add_argument("--l0-over-d0", type=float, nargs=2, default=(17.0, 20.0),
+                   metavar=("LO", "HI"), help="range of L0/D0 (default 17 20)")
+    p.add_argument("--sequential-rods", type=int, default=None,
+                   help="tie only this many one by one and extrapolate (default: all)")
+    p.set_defaults(handler=_command)
+
+
+def _command(args) -> int:  # noqa: ANN001
+    from tightknot.atomic import write_json_atomic
+    from tightknot.cli import _writable_file
+
+    out = _writable_file(args.json)
+    if args.nodes < 24:
+        raise ValueError(f"--nodes must be >= 24, got {args.nodes}")
+    r = run(args.rods, args.nodes, tuple(args.l0_over_d0), args.sequential_rods)
+    note = " (extrapolated)" if r["sequential_extrapolated"] else ""
+    print(f"{r['rods']} closed trefoils of {r['vertices']} vertices: batched "
+          f"{r['batched_s']:.2f} s ({r['batched_newton_iterations']} iterations), sequential "
+          f"{r['sequential_s']:.2f} s{note} ({r['sequential_newton_iterations']} iterations)")
+    print(f"speedup {r['speedup']:.2f} (target >= {TARGET_SPEEDUP:g}); largest difference "
+          f"{r['max_position_diff_over_D0']:.2e} D0")
+    c = r["iteration_cost"]
+    for k in ("single_rod", "batched_per_rod"):
+        print(f"  {k:>16s}: evaluate {c[k]['evaluate_s'] * 1e3:.2f} ms, factorize+solve "
+              f"{c[k]['factorize_solve_s'] * 1e3:.2f} ms")
+    if out is not None:
+        write_json_atomic(out, r)
+    return 0
