@@ -90,8 +90,15 @@ def _default_twist(knot: str) -> bool:
     return knot == "closed_trefoil"  # scenes.py: closed on, open off
 
 
-def run_case(knot: str, nodes: int, level: Level, residual_tol: float) -> dict:
-    """Tie one knot and measure it; the row keeps the profile for the comparison."""
+class _OverBudget(Exception):
+    """A run went past its time budget (raised from the progress callback)."""
+
+
+def run_case(knot: str, nodes: int, level: Level, residual_tol: float,
+             budget_s: float = math.inf) -> dict:
+    """Tie one knot and measure it; the row keeps the profile for the comparison. A run
+    still going after ``budget_s`` [s] is stopped at its next converged load step and
+    recorded as failed, with its time (the study must end in bounded time)."""
     from tightknot.knots.run import run_knot
 
     t0 = time.perf_counter()
@@ -99,7 +106,23 @@ def run_case(knot: str, nodes: int, level: Level, residual_tol: float) -> dict:
     opts: dict = {"residual_tol": residual_tol}
     if not scene.closed:
         opts["pull_force"] = OPEN_PULL_FORCE_N
-    run = run_knot(scene, **opts)
+
+    def watch(*_args: object) -> None:
+        if time.perf_counter() - t0 > budget_s:
+            raise _OverBudget
+
+    try:
+        run = run_knot(scene, progress=watch, **opts)
+    except _OverBudget:
+        wall = time.perf_counter() - t0
+        return {"knot": knot, "vertices": nodes, "contact": level.contact,
+                "twist": bool(scene.model.twist), "level": level.label(_default_twist(knot)),
+                "residual_tol": residual_tol, "converged": False,
+                "failure": f"stopped after {wall:.0f} s: over the time budget of "
+                           f"{budget_s:g} s per run", "wall_time_s": wall,
+                "newton_iterations": -1, "measure_name": "L_over_D" if scene.closed
+                else "Lambda_OC", "measure": None, "min_area_ratio": math.nan,
+                "_closed": scene.closed}
     wall = time.perf_counter() - t0
     s = run.summary
     rest = scene.model.edge_rest_length
@@ -202,16 +225,17 @@ def _grid(spec: dict, tolerances: tuple[float, ...]) -> list[tuple[str, int, Lev
 
 
 def run(spec: dict | None = None, tolerances: tuple[float, ...] = TOLERANCES,
-        progress=None) -> dict:  # noqa: ANN001 (a print-like callable)
-    """Run the study (``spec`` per knot: ``nodes`` of the full model, ``level_nodes`` of
-    the other levels); the finest full-model run is each knot's reference."""
+        progress=None, budget_s: float = math.inf) -> dict:  # noqa: ANN001 (print-like)
+    """Run the study (``spec`` per knot: ``nodes`` of the full model, ``levels`` and the
+    ``level_nodes`` they run at); the finest full-model run is each knot's reference;
+    ``budget_s``: time budget per run [s]."""
     spec = FULL if spec is None else spec
     if not tolerances or any(not (math.isfinite(t) and t > 0) for t in tolerances):
         raise ValueError(f"tolerances must be finite and > 0, got {tolerances!r}")
     rows = []
     t_all = time.perf_counter()
     for knot, n, lev, tol in _grid(spec, tuple(sorted(tolerances))):
-        row = run_case(knot, n, lev, tol)
+        row = run_case(knot, n, lev, tol, budget_s)
         rows.append(row)
         if progress is not None:
             progress(f"{knot:>15s} {n:>4d} vertices, {row['level']:>22s}, tol {tol:.0e}: "
@@ -223,12 +247,14 @@ def run(spec: dict | None = None, tolerances: tuple[float, ...] = TOLERANCES,
     clean = []
     for r in rows:
         c = {k: v for k, v in r.items() if not k.startswith("_")}
-        for k in ("measure", "kappa_rms_error", "measure_error", "area_error"):
+        for k in ("measure", "min_area_ratio", "kappa_rms_error", "measure_error",
+                  "area_error"):
             c[k] = _finite_or_none(c.get(k))
         clean.append(c)
     return {"rows": clean, **summary, "accept": ACCEPT, "open_pull_force_N": OPEN_PULL_FORCE_N,
-            "open_rest_length_m": OPEN_REST_LENGTH, "total_wall_time_s":
-            time.perf_counter() - t_all}
+            "open_rest_length_m": OPEN_REST_LENGTH, "budget_per_run_s":
+            None if math.isinf(budget_s) else budget_s,
+            "total_wall_time_s": time.perf_counter() - t_all}
 
 
 def plot(result: dict, path: Path) -> None:
@@ -302,6 +328,9 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--json", metavar="FILE", help="write the result as JSON (+ FILE.png)")
     p.add_argument("--quick", action="store_true", help="a small version (a few minutes)")
+    p.add_argument("--budget", type=float, default=None, metavar="S",
+                   help="time budget per run [s] (default 60 with --quick, 180 otherwise); "
+                   "a run over it is recorded as failed")
     p.set_defaults(handler=_command)
 
 
@@ -310,7 +339,10 @@ def _command(args) -> int:  # noqa: ANN001
     from tightknot.cli import _writable_file
 
     out = _writable_file(args.json)
-    result = run(QUICK if args.quick else FULL, progress=print)
+    budget = args.budget if args.budget is not None else (60.0 if args.quick else 180.0)
+    if not (math.isfinite(budget) and budget > 0):
+        raise ValueError(f"--budget must be finite and > 0 s, got {args.budget!r}")
+    result = run(QUICK if args.quick else FULL, progress=print, budget_s=budget)
     for knot, rec in result["recommended"].items():
         if rec is None:
             print(f"{knot}: no run within the acceptance of the finest one")
