@@ -34,14 +34,19 @@ def distance_for_overlap(delta_over_d: float) -> float:
     return (1.0 - delta_over_d) * D
 
 
-@pytest.mark.parametrize("angle, gap", [(90.0, 0.9), (60.0, 0.7), (25.0, 0.8),
-                                        (5.0, 0.85), (0.5, 0.95)])
-def test_gradient_and_hessian_match_finite_differences(angle: float, gap: float) -> None:
+@pytest.mark.parametrize("angle, gap, law", [
+    (90.0, 0.9, LAW), (60.0, 0.7, LAW), (25.0, 0.8, LAW), (5.0, 0.85, LAW), (0.5, 0.95, LAW),
+    # Inside the hard core's band (below 0.7 R), crossing and near parallel:
+    (90.0, 0.45, LAW), (5.0, 0.55, LAW),
+    # A rigid tube between its barrier's start (R) and its divergence (0.98 R):
+    (5.0, 0.99, LAW.rigid_tube())])  # (positions jitter by 0.002 D there, not 0.01 D)
+def test_gradient_and_hessian_match_finite_differences(angle: float, gap: float,
+                                                        law: RadialComplianceLaw) -> None:
     # Crossing (90, 60), the line-to-point blend (25), near parallel (5, 0.5 deg); rest
     # lengths 3 % longer than the edges, so the sections are compressed and their radii
-    # r0 (l/l_bar)^-nu enter the derivatives.
-    m = two_rods(angle, gap * D, n=6, length=0.03, noise=0.01)
-    cl = ContactLayer(m, LAW, gauss_points=2)
+    # r0 (l/l_bar)^-nu enter the derivatives (of the law and of the hard core's band).
+    m = two_rods(angle, gap * D, n=6, length=0.03, noise=0.002 if law.rigid else 0.01)
+    cl = ContactLayer(m, law, gauss_points=2)
     x0 = m.vertex_initial_position.copy()
     rest = m.edge_rest_length * 1.03
     e0, g0, coo = cl.evaluate(x0, rest, True, True)
@@ -76,10 +81,11 @@ def test_parallel_strands_follow_the_line_law(delta_over_d: float) -> None:
     # Two parallel straight rods held at overlap delta = D - d: the contact force per unit
     # length at mid-rod is the line law's f = de_line/d delta = K m delta^(m-1), at every
     # overlap (the kernel is the law's Abel inverse). Quadrature with 2 Gauss points on
-    # edges of D/8: measured within 0.3 % from delta = 0.05 D to 0.6 D; 2 % bound.
+    # edges of D/8: measured within 0.3 % from delta = 0.05 D to 0.6 D; 2 % bound. The
+    # hard core is moved out of the way (core_fraction 0.3) to see the law alone.
     d = (1.0 - delta_over_d) * D
     m = two_rods(0.0, d, n=161)
-    cl = ContactLayer(m, LAW, gauss_points=2)
+    cl = ContactLayer(m, LAW, gauss_points=2, core_fraction=0.3)
     _, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
     h = m.edge_rest_length[0]
     f_model = -g[m.rods[1].vertex_start + 80, 2] / h
@@ -95,10 +101,11 @@ def test_parallel_strands_follow_the_line_law(delta_over_d: float) -> None:
 @pytest.mark.parametrize("delta_over_d", [0.05, 0.1, 0.3, 0.6])
 def test_crossed_strands_follow_the_point_law(delta_over_d: float) -> None:
     # Two rods crossing at 90 degrees: the total contact force is the point law's
-    # F = K m delta^(m-1), at every overlap; measured within 0.7 %; 3 % bound.
+    # F = K m delta^(m-1), at every overlap; measured within 0.7 %; 3 % bound (the law
+    # alone: hard core out of the way, as above).
     d = (1.0 - delta_over_d) * D
     m = two_rods(90.0, d, n=161)
-    cl = ContactLayer(m, LAW, gauss_points=2)
+    cl = ContactLayer(m, LAW, gauss_points=2, core_fraction=0.3)
     _, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
     f_model = -g[m.rods[1].vertex_slice, 2].sum()
     f_law = float(LAW.point_force(delta_over_d * D - LAW.onset_band * D, E, D))

@@ -88,14 +88,20 @@ class ContactLayer:
             in the module docstring).
         hard_fraction: hard limit of the centerline distance over the pair's rest diameter;
             a Newton step never brings two non-local segments closer.
-        core_fraction: a hard-core barrier adds to the law over a band of width
-            (core_fraction - hard_fraction) D above the distance where it diverges,
-            hard_fraction D + 0.58 l (l the longer rest edge: every polyline point is within
-            0.29 l of a Gauss point, so the barrier stops two segments before the step bound
-            would). An IPC barrier (Li et al. 2020), zero outside the band and C2; with
-            edges below 0.3 D it acts only beyond the calibrated range (pair overlap 0.3 D),
-            and lets Newton steps stop short of the limit instead of jamming against it.
-        core_stiffness: the barrier's stiffness over E D (energy per length^2).
+        core_fraction: the hard core: an IPC barrier (Li et al. 2020, eq. 6), zero and C2
+            at centerline distances above core_fraction R (R = r_a + r_b, the contact radius
+            of the stretched sections), diverging at rho_h = max(hard_relative R,
+            hard_fraction D + 0.58 l) (l the longer rest edge: every polyline point is
+            within 0.29 l of a Gauss point, so the barrier stops two segments before the
+            step bound would). Default 0.7 for a compliant law: the barrier takes over where
+            the FEM calibration ends (pair overlap 0.3 R); beyond it the power law alone is
+            far too soft (measured: a tight 125 mm trefoil pulled past 7 N snapped to a gap
+            of 0.12 D0, sections squeezed to a third), whereas an incompressible section
+            stiffens. Default 1.0 for a rigid tube.
+        core_stiffness: the barrier's stiffness over E/D (energy per length^2 over the
+            square of the distance into the band).
+        hard_relative: see core_fraction; default 0 (compliant: only the absolute floor),
+            0.98 for a rigid tube (its hard radius: the barrier diverges at 0.98 R).
         initial_capacity: first size of the candidate-pair buffer (grows on demand).
     """
 
@@ -108,8 +114,9 @@ class ContactLayer:
         gauss_points: int = 2,
         exclusion_factor: float = math.pi / 2,
         hard_fraction: float = 0.05,
-        core_fraction: float = 0.25,
+        core_fraction: float | None = None,
         core_stiffness: float = 1.0,
+        hard_relative: float | None = None,
         initial_capacity: int = 1024,
     ) -> None:
         init_warp()
@@ -117,13 +124,22 @@ class ContactLayer:
             raise ValueError(f"gauss_points must be 1, 2 or 3, got {gauss_points}")
         if not (math.isfinite(exclusion_factor) and exclusion_factor >= math.pi / 2):
             raise ValueError(f"exclusion_factor must be >= pi/2, got {exclusion_factor}")
-        if not (0.0 < hard_fraction < core_fraction < 0.7):
-            raise ValueError("need 0 < hard_fraction < core_fraction < 0.7 (the calibrated "
-                             f"range ends at d = 0.7 D), got {hard_fraction}, {core_fraction}")
+        self.law = law or RadialComplianceLaw.from_json()
+        rigid = self.law.rigid
+        if core_fraction is None:
+            core_fraction = 1.0 if rigid else 0.7
+        if hard_relative is None:
+            hard_relative = 0.98 if rigid else 0.0
+        if not (0.0 < hard_fraction < 0.5):
+            raise ValueError(f"hard_fraction must be in (0, 0.5), got {hard_fraction}")
+        if not (0.0 <= hard_relative < core_fraction <= 1.0):
+            raise ValueError("need 0 <= hard_relative < core_fraction <= 1 (fractions of the "
+                             f"contact radius R), got {hard_relative}, {core_fraction}")
         if not (math.isfinite(core_stiffness) and core_stiffness > 0):
             raise ValueError(f"core_stiffness must be finite and > 0, got {core_stiffness}")
         self.model = model
-        self.law = law or RadialComplianceLaw.from_json()
+        self.core_fraction = float(core_fraction)
+        self.hard_relative = float(hard_relative)
         self.hard_fraction = float(hard_fraction)
         dev = model.device
         self.device = dev
@@ -149,7 +165,7 @@ class ContactLayer:
         self._law = wp.array([
             law_.k_line, law_.p_line + 1.0, 0.0, law_.k_point, law_.p_point + 1.0,
             math.cos(math.radians(law_.angle_line_deg)) ** 2,
-            math.cos(math.radians(law_.angle_point_deg)) ** 2, 0.0,
+            math.cos(math.radians(law_.angle_point_deg)) ** 2, hard_relative,
             core_fraction, hard_fraction, core_stiffness,
             U_MIN, (1.0 - U_MIN) / TABLE_INTERVALS,
         ], dtype=f64, device=dev)
@@ -208,7 +224,8 @@ class ContactLayer:
         while True:
             self._count.zero_()
             wp.launch(ck.candidate_pairs_kernel, dim=m.edge_count, device=dev,
-                      inputs=[self._edge_rod, self._rod_closed, bvh.id, lower, upper, arcs,
+                      inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, bvh.id,
+                              lower, upper, arcs,
                               rod_len, self._exclusion, self._capacity],
                       outputs=[self._count, self._pairs])
             n = int(self._count.numpy()[0])

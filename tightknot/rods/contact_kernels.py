@@ -81,27 +81,42 @@ def scaled_kernel(T: wp.vec3d, amp: wp.float64, k: wp.float64, R: wp.float64,
 
 
 @wp.func
-def hard_core(s: wp.float64, rho_hard: wp.float64, rho_core: wp.float64,
-              k: wp.float64) -> wp.vec3d:
-    """Barrier b = -k (y - yc)^2 ln(y/yc), y = rho - rho_hard, yc = rho_core - rho_hard, as a
-    function of s = rho^2, with db/ds and d2b/ds2 (zero for rho >= rho_core)."""
-    rho = wp.sqrt(s)
-    if rho >= rho_core:
-        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
-    if rho <= rho_hard:
+def hard_core(rho: wp.float64, R: wp.float64, hard_abs: wp.float64, hard_rel: wp.float64,
+              core_rel: wp.float64, k: wp.float64) -> wp.mat33d:
+    """Barrier b = -k dy^2 ln(y/yc) of the centerline distance rho and the contact radius
+    R = r_a + r_b (Li et al. 2020, eq. 6, shifted): y = rho - rho_h, yc = rho_c - rho_h,
+    dy = rho - rho_c, with the band's start rho_c = core_rel R (where the calibrated law
+    ends) and its divergence rho_h = max(hard_rel R, hard_abs). Zero and C2 at rho_c.
+
+    Returns rows (b, b_rho, b_rhorho), (b_R, b_rhoR, b_RR), (0, 0, 0)."""
+    out = wp.mat33d()
+    rho_c = core_rel * R
+    rho_h = hard_abs
+    h1 = f64(0.0)
+    if hard_rel * R > hard_abs:
+        rho_h = hard_rel * R
+        h1 = hard_rel
+    if rho >= rho_c or rho_c <= rho_h:
+        return out
+    if rho <= rho_h:
         # Outside the barrier's domain: an energy no line search accepts.
-        return wp.vec3d(f64(1.0e300), f64(0.0), f64(0.0))
-    y = rho - rho_hard
-    yc = rho_core - rho_hard
+        out[0, 0] = f64(1.0e300)
+        return out
+    c1 = core_rel
+    y = rho - rho_h
+    yc = rho_c - rho_h
+    dy = rho - rho_c
     lg = wp.log(y / yc)
-    dy = y - yc
-    b = -k * dy * dy * lg
-    b1 = -k * (f64(2.0) * dy * lg + dy * dy / y)
-    b2 = -k * (f64(2.0) * lg + f64(4.0) * dy / y - dy * dy / (y * y))
-    # Chain rule to s = rho^2: d/ds = (1/(2 rho)) d/drho.
-    bs = b1 / (f64(2.0) * rho)
-    bss = (b2 - b1 / rho) / (f64(4.0) * s)
-    return wp.vec3d(b, bs, bss)
+    lr = -h1 / y - (c1 - h1) / yc                       # d ln(y/yc) / dR
+    lrr = -(h1 * h1) / (y * y) + ((c1 - h1) * (c1 - h1)) / (yc * yc)
+    out[0, 0] = -k * dy * dy * lg
+    out[0, 1] = -k * (f64(2.0) * dy * lg + dy * dy / y)
+    out[0, 2] = -k * (f64(2.0) * lg + f64(4.0) * dy / y - dy * dy / (y * y))
+    out[1, 0] = -k * (-f64(2.0) * c1 * dy * lg + dy * dy * lr)
+    out[1, 1] = -k * (-f64(2.0) * c1 * lg + f64(2.0) * dy * lr - f64(2.0) * c1 * dy / y
+                      + h1 * dy * dy / (y * y))
+    out[1, 2] = -k * (f64(2.0) * c1 * c1 * lg - f64(4.0) * c1 * dy * lr + dy * dy * lrr)
+    return out
 
 
 @wp.func
@@ -213,6 +228,7 @@ def edge_bounds_kernel(
 @wp.kernel
 def candidate_pairs_kernel(
     # Model:
+    edge_vertex: wp.array(dtype=wp.vec2i),
     edge_rod: wp.array(dtype=wp.int32),
     rod_closed: wp.array(dtype=wp.int32),
     # Data in:
@@ -234,8 +250,14 @@ def candidate_pairs_kernel(
     b = int(0)
     ra = edge_rod[a]
     arc_a = edge_arc_in[a]
+    va = edge_vertex[a]
     while wp.bvh_query_next(query, b):
         if b <= a:
+            continue
+        # Edges that share a vertex are neighbours, never a contact (edges longer than the
+        # exclusion window would otherwise pair up and touch at their common vertex).
+        vb = edge_vertex[b]
+        if va[0] == vb[0] or va[0] == vb[1] or va[1] == vb[0] or va[1] == vb[1]:
             continue
         same = int(0)
         if edge_rod[b] == ra:
@@ -307,7 +329,8 @@ def contact_pair_kernel(
     lb = wp.length(eb)
     ta = ea / la
     tb = eb / lb
-    # Law parameters: [K_line coef, m_line, -, K_point coef, m_point, q_line, q_point, -,
+    # Law parameters: [K_line coef, m_line, -, K_point coef, m_point, q_line, q_point,
+    #                  hard_relative,
     #                  core_fraction, hard_fraction, core_stiffness, u0, du].
     m_l = law[1]
     m_p = law[4]
@@ -368,16 +391,18 @@ def contact_pair_kernel(
         B = xi * sn
         B1 = xi1 * sn + xi * s1
         B2 = xi2 * sn + f64(2.0) * xi1 * s1 + xi * s2
-    # Hard core (IPC barrier, Li et al. 2020, eq. 6, shifted to the hard limit): zero for
-    # rho >= core, C2 there, infinite at the hard limit that the step bound guards.
+    # Hard core (IPC barrier, Li et al. 2020, eq. 6, see hard_core): zero for
+    # rho >= core_fraction R, C2 there, infinite before the hard limit of the step bound.
     # Every point of a polyline is within 0.29 l of one of its Gauss points (2 per edge:
     # 0.577 l apart inside an edge, 0.42 l across a vertex; 3 per edge: closer), so the
     # barrier diverges at rho_hard = hard + 0.58 l_max: it stops two segments before their
     # distance reaches the step bound's hard limit, whatever Gauss points they hold.
     lmax = wp.max(edge_rest_length_in[a], edge_rest_length_in[b])
     rho_hard = hard_frac * d0 + f64(0.58) * lmax
-    rho_core = rho_hard + (core_frac - hard_frac) * d0
-    kcore = core_k * emod * d0
+    hard_rel = law[7]
+    # Barrier stiffness [J/m^2 per m^2 of (rho - rho_core)^2]: k E / D, so that the
+    # barrier density k E D (dy/D)^2 ln(y/yc) is an energy per length^2 like the law's.
+    kcore = core_k * emod / d0
     ng = gauss_xi.shape[0]
     ra_ = edge_rod[a]
     same = int(0)
@@ -434,7 +459,15 @@ def contact_pair_kernel(
             u = rho / R
             Fl = scaled_kernel(table_eval(line_table, u0, du, u), A_l, k_l, R, u)
             Fp = scaled_kernel(table_eval(point_table, u0, du, u), A_p, k_p, R, u)
-            bv = hard_core(s, rho_hard, rho_core, kcore)
+            hb = hard_core(rho, R, rho_hard, hard_rel, core_frac, kcore)
+            if hb[0, 0] >= f64(1.0e299):
+                # Past the barrier's divergence: an energy no line search accepts, and no
+                # derivatives (they would overflow the assembled matrix).
+                energy += f64(1.0e300)
+                continue
+            # The barrier in s = rho^2: b_s = b_rho/(2 rho), b_ss = (b_rr - b_r/rho)/(4 s).
+            bv = wp.vec3d(hb[0, 0], hb[0, 1] * f64(0.5) / rho,
+                          (hb[0, 2] - hb[0, 1] / rho) / (f64(4.0) * s))
             Psi = A * Fl[0, 0] + B * Fp[0, 0] + bv[0]
             wgt = gauss_w[gi] * gauss_w[hi] * wex
             P = la * lb
@@ -451,10 +484,10 @@ def contact_pair_kernel(
             Qss = (Fp[1, 0] - Fp[0, 1] / rho) / (f64(4.0) * s)
             QsR = Fp[1, 1] * inv2r
             Ps = A * Ls + B * Qs + bv[1]
-            PR = A * Fl[0, 2] + B * Fp[0, 2]
+            PR = A * Fl[0, 2] + B * Fp[0, 2] + hb[1, 0]
             Pss = A * Lss + B * Qss + bv[2]
-            PsR = A * LsR + B * QsR
-            PRR = A * Fl[1, 2] + B * Fp[1, 2]
+            PsR = A * LsR + B * QsR + hb[1, 1] * f64(0.5) / rho
+            PRR = A * Fl[1, 2] + B * Fp[1, 2] + hb[1, 2]
             Pq = A1 * Fl[0, 0] + B1 * Fp[0, 0]
             Pqq = A2 * Fl[0, 0] + B2 * Fp[0, 0]
             Psq = A1 * Ls + B1 * Qs

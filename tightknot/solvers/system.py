@@ -155,6 +155,8 @@ class RodSystem:
         st.x, st.d1_ref, st.t_ref, st.m_ref = x, d1, tt, mref
         self.bcs.prescribe_twist(self.t, st.theta, st.d1_ref, st.t_ref)
         self._trial = None
+        # A new load step: contact blocks that stopped interacting leave the pattern.
+        self.compact_pattern()
 
     # -- dof vectors -----------------------------------------------------------------
     def full_dofs(self) -> np.ndarray:

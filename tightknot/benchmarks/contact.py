@@ -1,0 +1,141 @@
+"""What self-contact adds to a Newton iteration (the contact issue's speed target).
+
+Scene: the study's tight open trefoil (125 mm, 300 vertices, pulled by 5.67 N to Lambda_OC
+about 10.1). At that equilibrium one Newton iteration is timed piece by piece, each the
+minimum over repeats (the machines are shared: the minimum is the least disturbed run):
+
+- ``elastic_s``: stretch, bend and twist energy, gradient and Hessian (Warp);
+- ``contact_s``: the contact layer's detection (BVH broad phase, candidate pairs) and its
+  energy, gradient and Hessian added into the system's CSC data, plus the combination with
+  the elastic part into one matrix: the whole system evaluation minus ``elastic_s``;
+- ``step_bound_s``: the continuous collision bound of the step (no passing through);
+- ``solve_s``: sparse LU and solve of the Hessian with contact couplings;
+- ``solve_no_contact_s``: the same for the elastic Hessian alone.
+
+The target reads: contact detection plus contact assembly add at most 50 % to a Newton
+iteration, i.e. ``(contact_s + step_bound_s) / (elastic_s + solve_s) <= 0.5``; the
+fill-in that contact couplings bring into the factorization is reported apart, as
+``solve_s / solve_no_contact_s`` (it is the linear solver's cost, not the layer's).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+#: The tight open knot of the study: rest length [m], pulling force [N], vertices.
+SCENE = {"rest_length_m": 0.125, "pull_force_N": 5.67, "vertices": 300}
+
+
+def _best(f: Callable[[], Any], repeats: int) -> float:
+    f()
+    best = np.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        f()
+        best = min(best, time.perf_counter() - t0)
+    return float(best)
+
+
+def run(vertices: int = 300, repeats: int = 30, device: str = "cpu") -> dict:
+    """Tie the tight open trefoil with ``vertices`` vertices and time one Newton iteration's
+    parts at its equilibrium (seconds)."""
+    from tightknot.knots.scenes import gauge, open_trefoil
+    from tightknot.knots.tie import lambda_oc, tie
+    from tightknot.solvers.linear import factorize
+    from tightknot.solvers.system import RodSystem
+
+    if vertices < 60:
+        raise ValueError(f"vertices must be >= 60 (a trefoil of 125 mm), got {vertices}")
+    scene = open_trefoil(SCENE["rest_length_m"], nodes=vertices, device=device)
+    t0 = time.perf_counter()
+    res = tie(scene, pull_force=SCENE["pull_force_N"])
+    tie_s = time.perf_counter() - t0
+    if not res.converged:
+        raise RuntimeError(f"the benchmark scene did not converge: {res.failure}")
+    st = res.system.state
+    rest = res.system.rest
+    bare = RodSystem(scene.model, st.copy(), gauge(scene, positions=st.x))
+    full = RodSystem(scene.model, st.copy(), gauge(scene, positions=st.x))
+    full.add_term(scene.contact)
+    bare.rest = rest
+    full.rest = rest
+    u = full.free_vector()
+    _, g, h_full = full.evaluate(u)
+    _, _, h_bare = bare.evaluate(u)
+    du = factorize(h_full).solve(-g)
+    elastic = _best(lambda: bare.evaluate(u), repeats)
+    system = _best(lambda: full.evaluate(u), repeats)
+    step = _best(lambda: full.max_step(u, du), repeats)
+    solve = _best(lambda: factorize(h_full).solve(g), repeats)
+    solve0 = _best(lambda: factorize(h_bare).solve(g), repeats)
+    contact = max(system - elastic, 0.0)
+    pairs = scene.contact.last_pairs.shape[0]
+    active = int(np.count_nonzero(scene.contact.last_overlap > 0.0))
+    overhead = (contact + step) / (elastic + solve)
+    return {
+        "scene": dict(SCENE, vertices=vertices),
+        "lambda_oc": lambda_oc(st.x, scene.diameter),
+        "tie_s": tie_s,
+        "candidate_pairs": pairs,
+        "interacting_pairs": active,
+        "elastic_s": elastic,
+        "contact_s": contact,
+        "step_bound_s": step,
+        "solve_s": solve,
+        "solve_no_contact_s": solve0,
+        "iteration_s": elastic + contact + step + solve,
+        "contact_overhead": overhead,
+        "target_overhead": 0.5,
+        "passed": bool(overhead <= 0.5),
+        "solve_fill_ratio": solve / solve0,
+        "hessian_nnz": int(h_full.nnz),
+        "hessian_nnz_no_contact": int(h_bare.nnz),
+    }
+
+
+# -- command line (``tightknot bench contact``) ---------------------------------------------
+_EXAMPLES = """examples:
+  tightknot bench contact --json contact.json
+  tightknot bench contact --vertices 600
+"""
+
+
+def register(subparsers: Any) -> None:
+    """Add ``tightknot bench contact``."""
+    p = subparsers.add_parser(
+        "contact", help="what self-contact adds to a Newton iteration (tight open trefoil)",
+        description=__doc__, epilog=_EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--json", metavar="FILE", help="write the result as JSON")
+    p.add_argument("--vertices", type=int, default=SCENE["vertices"],
+                   help="vertices of the knot (default 300)")
+    p.add_argument("--repeats", type=int, default=30, help="timing repeats (minimum kept)")
+    p.add_argument("--device", default=None, help="Warp device (default cpu)")
+    p.set_defaults(handler=_command)
+
+
+def _command(args: argparse.Namespace) -> int:
+    from tightknot.atomic import write_json_atomic
+    from tightknot.cli import _writable_file
+    from tightknot.warp_setup import resolve_device
+
+    out = _writable_file(args.json)
+    if args.repeats < 1:
+        raise ValueError(f"--repeats must be >= 1, got {args.repeats}")
+    r = run(args.vertices, args.repeats, resolve_device(args.device))
+    print(f"tight open trefoil, {args.vertices} vertices, Lambda_OC {r['lambda_oc']:.2f}: "
+          f"{r['candidate_pairs']} candidate pairs, {r['interacting_pairs']} interacting")
+    for k in ("elastic_s", "contact_s", "step_bound_s", "solve_s", "solve_no_contact_s",
+              "iteration_s"):
+        print(f"  {k:20s} {r[k] * 1e3:8.3f} ms")
+    print(f"  contact overhead {r['contact_overhead']:.2f} (target <= 0.5): "
+          f"{'met' if r['passed'] else 'MISSED'}; LU with/without contact "
+          f"{r['solve_fill_ratio']:.1f}x")
+    if out is not None:
+        write_json_atomic(out, r)
+    return 0
