@@ -40,12 +40,12 @@ def test_demo_outputs(tmp_path) -> None:
     # The open knots' series: end-to-end distance, pulling force, Lambda_OC once in contact.
     for key in ("end_to_end", "pulling_force", "lambda_oc"):
         assert f"/plots/open_125mm/{key}" in paths, key
-    # Each knot's rod is logged once per converged load step of its tightening, plus once for
-    # the final state the force search toward Lambda_OC ends in (not a load step).
+    # Each knot's rod is logged once per converged load step: those of its tightening and
+    # each equilibrium of the force search toward Lambda_OC (the last is the final state).
     closed_steps = steps(rrd, "/closed/rod/vertices", "Points3D:positions")
     assert len(closed_steps) == closed["load_steps"]
     tight_steps = steps(rrd, "/open_125mm/rod/vertices", "Points3D:positions")
-    assert len(tight_steps) == tight["load_steps"] + 1
+    assert len(tight_steps) == tight["load_steps"]
     # The final force of the search is the last logged pulling force (float32 in rerun).
     _, force = scalar_series(rrd, "/plots/open_125mm/pulling_force")
     assert abs(force[-1] - tight["pull_force_N"]) <= 1e-4 * tight["pull_force_N"]

@@ -180,24 +180,29 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
     tube coloured by ``color_by`` and reporting it to ``progress``.
 
     The final state is logged as one more step whenever it is not the last logged one (a
-    failed run, whose last attempt did not converge, or a pull to a target Lambda_OC, whose
-    force steps are not load steps), so the .rrd always ends on the state the summary
-    describes. ``summary["load_steps"]`` counts the converged load steps of the continuation
-    (the force steps of a pull to a target Lambda_OC are not load steps).
+    failed run, whose last attempt did not converge), so the .rrd always ends on the state
+    the summary describes. ``summary["load_steps"]`` counts the converged load steps, each
+    passed to the hook: those of the continuation and, in a pull to a target Lambda_OC,
+    each equilibrium of the force search.
     """
     check_color_field(color_by)
     name = name or scene.name
     counter = counter if counter is not None else [0]
     logged: dict = {}
     # Always hooked: the hook numbers the steps on the timeline and reports progress.
-    hook = logging_hook(log, scene, name, counter, color_by, progress, logged)
+    inner = logging_hook(log, scene, name, counter, color_by, progress, logged)
+    calls = [0]
+
+    def hook(phase: str, system: RodSystem, rec: Any) -> None:
+        calls[0] += 1
+        inner(phase, system, rec)
+
     target = tie_options.pop("target_lambda", None)
     if target is not None:
         res = tie_to_lambda(scene, target, hook=hook, **tie_options)
     else:
         res = tie(scene, hook=hook, **tie_options)
-    # The solver's own record of converged load steps (each one was passed to the hook).
-    load_steps = sum(len(p.steps) for p in res.phases.values())
+    load_steps = calls[0]
     x = res.system.state.x
     if log is not None and not np.array_equal(logged.get("x"), x):
         log.set_step(counter[0])

@@ -109,6 +109,9 @@ def tie(
         relax_iterations: Newton budget of the relaxation of the start curve.
         hook: called after each converged step with (phase, system, record).
     """
+    if scene.contact is None:
+        raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
+                         "the rod passes through itself); use 'compliant' or 'rigid'")
     if pull_force is not None and end_distance is not None:
         raise ValueError("give pull_force or end_distance, not both")
     if scene.closed and (pull_force is not None or end_distance is not None):
@@ -307,6 +310,9 @@ def tie_to_lambda(
         if kt != scene.knot_type:
             return False, math.nan, (f"knot type {kt} at force {f:.4g} N (the knot slipped "
                                      "off an end, or the rod passed through itself)")
+        if hook is not None:
+            # Each equilibrium of the force search is a load step of the run's log.
+            hook("pull", pull, StepRecord(1.0, r))
         x = pull.state.x
         return True, lambda_oc(x, scene.diameter, vertex_radii(scene, x, pull.rest)[1]), ""
 
