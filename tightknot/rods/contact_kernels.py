@@ -65,11 +65,10 @@ def table_eval(table: wp.array2d(dtype=wp.float64), u0: wp.float64, du: wp.float
 
 
 @wp.func
-def scaled_kernel(T: wp.vec3d, amp: wp.float64, k: wp.float64, R: wp.float64,
+def scaled_kernel(T: wp.vec3d, rk: wp.float64, k: wp.float64, R: wp.float64,
                   u: wp.float64) -> wp.mat33d:
-    """f = amp R^k T(rho/R) and its derivatives, packed as
-    [[f, f_rho, f_R], [f_rhorho, f_rhoR, f_RR], [0, 0, 0]]."""
-    rk = amp * wp.pow(R, k)
+    """f = rk T(rho/R) with rk = amp R^k (computed once per pair), and its derivatives,
+    packed as [[f, f_rho, f_R], [f_rhorho, f_rhoR, f_RR], [0, 0, 0]]."""
     f = rk * T[0]
     f_r = rk / R * T[1]
     f_R = rk / R * (k * T[0] - u * T[1])
@@ -341,6 +340,39 @@ def contact_pair_kernel(
     core_k = law[10]
     u0 = law[11]
     du = law[12]
+    # Stretched radii r = r0 (l/l_bar)^-nu and their derivatives in l.
+    nua = edge_poisson[a]
+    nub = edge_poisson[b]
+    r_a = edge_radius0[a] * wp.pow(la / edge_rest_length_in[a], -nua)
+    r_b = edge_radius0[b] * wp.pow(lb / edge_rest_length_in[b], -nub)
+    R = r_a + r_b
+    # Most candidates do not interact: find the closest Gauss pair first and leave before
+    # the pair constants (powers) when it lies outside the contact radius.
+    ng = gauss_xi.shape[0]
+    ra_ = edge_rod[a]
+    same = int(0)
+    if edge_rod[b] == ra_:
+        same = 1
+    excl = wp.max(edge_exclusion_in[a], edge_exclusion_in[b])
+    arc_a = edge_arc_in[a]
+    arc_b = edge_arc_in[b]
+    s_min = f64(1.0e300)
+    for gi in range(ng):
+        for hi in range(ng):
+            xg = gauss_xi[gi]
+            xh = gauss_xi[hi]
+            if same != 0:
+                sa = arc_a[0] + xg * (arc_a[1] - arc_a[0])
+                sb = arc_b[0] + xh * (arc_b[1] - arc_b[0])
+                sep = arc_separation(sa, sb, same, rod_closed[ra_], rod_length_in[ra_])
+                if smooth_ramp((sep - excl) / (f64(0.25) * excl))[0] <= f64(0.0):
+                    continue
+            r = (xa0 + xg * ea) - (xb0 + xh * eb)
+            s_min = wp.min(s_min, wp.dot(r, r))
+    if s_min >= R * R:
+        energy_out[p] = f64(0.0)
+        overlap_out[p] = R - wp.sqrt(s_min)
+        return
     # Pair constants from the rest diameter D = r_a + r_b and the harmonic-mean modulus:
     # e_line = K_l delta^m_l with K_l = 2 k E D^2 (2D)^-m/m (contact_law), likewise K_p.
     d0 = edge_radius0[a] + edge_radius0[b]
@@ -354,12 +386,6 @@ def contact_pair_kernel(
     k_l = m_l - f64(1.0)
     A_p = K_p * m_p / (f64(2.0) * f64(3.141592653589793))
     k_p = m_p - f64(2.0)
-    # Stretched radii r = r0 (l/l_bar)^-nu and their derivatives in l.
-    nua = edge_poisson[a]
-    nub = edge_poisson[b]
-    r_a = edge_radius0[a] * wp.pow(la / edge_rest_length_in[a], -nua)
-    r_b = edge_radius0[b] * wp.pow(lb / edge_rest_length_in[b], -nub)
-    R = r_a + r_b
     R_a = -nua * r_a / la
     R_b = -nub * r_b / lb
     R_aa = nua * (nua + f64(1.0)) * r_a / (la * la)
@@ -403,14 +429,9 @@ def contact_pair_kernel(
     # Barrier stiffness [J/m^2 per m^2 of (rho - rho_core)^2]: k E / D, so that the
     # barrier density k E D (dy/D)^2 ln(y/yc) is an energy per length^2 like the law's.
     kcore = core_k * emod / d0
-    ng = gauss_xi.shape[0]
-    ra_ = edge_rod[a]
-    same = int(0)
-    if edge_rod[b] == ra_:
-        same = 1
-    excl = wp.max(edge_exclusion_in[a], edge_exclusion_in[b])
-    arc_a = edge_arc_in[a]
-    arc_b = edge_arc_in[b]
+    # amp R^k of the line and point kernels, once per pair.
+    rk_l = A_l * wp.pow(R, k_l)
+    rk_p = A_p * wp.pow(R, k_p)
     energy = f64(0.0)
     g0 = wp.vec3d()
     g1 = wp.vec3d()
@@ -457,8 +478,8 @@ def contact_pair_kernel(
             if rho >= R:
                 continue
             u = rho / R
-            Fl = scaled_kernel(table_eval(line_table, u0, du, u), A_l, k_l, R, u)
-            Fp = scaled_kernel(table_eval(point_table, u0, du, u), A_p, k_p, R, u)
+            Fl = scaled_kernel(table_eval(line_table, u0, du, u), rk_l, k_l, R, u)
+            Fp = scaled_kernel(table_eval(point_table, u0, du, u), rk_p, k_p, R, u)
             hb = hard_core(rho, R, rho_hard, hard_rel, core_frac, kcore)
             if hb[0, 0] >= f64(1.0e299):
                 # Past the barrier's divergence: an energy no line search accepts, and no
