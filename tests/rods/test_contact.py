@@ -143,6 +143,55 @@ def test_tight_u_turn_does_not_touch_itself() -> None:
     assert e2 > 0.0
 
 
+def _short_hairpin(radius: float, n_arc: int = 24) -> np.ndarray:
+    """A U-turn of centerline ``radius`` with legs of 0.6 D: every point pair is inside or
+    near the exclusion window (rod length about 1.2 D + pi radius)."""
+    phi = np.linspace(-math.pi / 2, math.pi / 2, n_arc)
+    arc = np.c_[radius * np.cos(phi), radius * np.sin(phi), 0 * phi]
+    legs = np.linspace(-0.6 * D, 0, 8)[:-1]
+    return np.vstack([np.c_[legs, -radius + 0 * legs, 0 * legs], arc,
+                      np.c_[legs[::-1], radius + 0 * legs, 0 * legs]])
+
+
+def test_a_fold_tighter_than_a_legal_bend_is_resisted() -> None:
+    # Inside the exclusion window the law is off; the optional local-thickness barrier keeps
+    # points an arc sep apart at least 0.7 D sin(sep/D) apart (the chord of the tightest
+    # legal bend, radius D/2). A short hairpin of radius D/2 is legal. Folded to radius
+    # 0.2 D (legs 0.4 D apart, pairs 0.8..1.6 D apart along the rod): resisted, and its
+    # gradient and Hessian match finite differences (1e-6 relative, as above).
+    def layer(pts: np.ndarray) -> tuple[ContactLayer, np.ndarray]:
+        b = RodBuilder(twist=False)
+        b.add_rod(pts, D, Material(E, 0.5, 1160.0))
+        m = b.finalize()
+        return ContactLayer(m, LAW, local_thickness=True), m
+    cl, m = layer(_short_hairpin(D / 2))
+    e_legal = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, False, False)[0]
+    cl, m = layer(_short_hairpin(0.2 * D))
+    x0 = m.vertex_initial_position.copy()
+    rest = m.edge_rest_length * 1.02
+    e0, g0, coo = cl.evaluate(x0, rest, True, True)
+    # The legal hairpin's polygon touches its legs at the limit (1e-15 J of law energy
+    # measured, its Gauss points lie on chords inside the circle); the fold is resisted.
+    assert e0 > 1e9 * e_legal and e0 > 0.0
+    dofs = m.position_dofs.ravel()
+    hess = sp.coo_matrix((coo[2], (coo[0], coo[1])), shape=(m.dof_count,) * 2).toarray()[
+        np.ix_(dofs, dofs)]
+    step = 1e-7 * D
+    n = dofs.size
+    gfd = np.zeros(n)
+    hfd = np.zeros((n, n))
+    for k in range(n):
+        dx = np.zeros(n)
+        dx[k] = step
+        ep, gp, _ = cl.evaluate(x0 + dx.reshape(-1, 3), rest, True, False)
+        em, gm, _ = cl.evaluate(x0 - dx.reshape(-1, 3), rest, True, False)
+        gfd[k] = (ep - em) / (2 * step)
+        hfd[k] = (gp - gm).ravel() / (2 * step)
+    g = g0.ravel()
+    assert np.abs(gfd - g).max() <= 1e-6 * np.abs(g).max()
+    assert np.abs(hfd - hess).max() <= 1e-6 * np.abs(hess).max()
+
+
 def test_step_bound_prevents_passing_through() -> None:
     # Rod 1 crosses 1.2 D above rod 0; a step that moves it 3 D down would pass through.
     m = two_rods(90.0, 1.2 * D, n=21, length=6 * D)

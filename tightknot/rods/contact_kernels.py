@@ -27,6 +27,7 @@ from __future__ import annotations
 import warp as wp
 
 f64 = wp.float64
+HALF_PI = wp.constant(wp.float64(1.5707963267948966))
 # Compile time: see the module docstring.
 wp.set_module_options({"max_unroll": 1})
 
@@ -237,6 +238,7 @@ def candidate_pairs_kernel(
     edge_arc_in: wp.array(dtype=wp.vec2d),
     rod_length_in: wp.array(dtype=wp.float64),
     edge_exclusion_in: wp.array(dtype=wp.float64),
+    local_window: wp.float64,
     capacity: int,
     # Out:
     count_out: wp.array(dtype=wp.int32),
@@ -269,7 +271,7 @@ def candidate_pairs_kernel(
             s2 = arc_separation(arc_a[1], arc_b[0], 1, rod_closed[ra], rod_length_in[ra])
             s3 = arc_separation(arc_a[0], arc_b[0], 1, rod_closed[ra], rod_length_in[ra])
             s4 = arc_separation(arc_a[1], arc_b[1], 1, rod_closed[ra], rod_length_in[ra])
-            if wp.max(wp.max(s1, s2), wp.max(s3, s4)) < excl:
+            if wp.max(wp.max(s1, s2), wp.max(s3, s4)) < local_window * excl:
                 continue
         k = wp.atomic_add(count_out, 0, 1)
         if k < capacity:
@@ -297,6 +299,7 @@ def contact_pair_kernel(
     edge_arc_in: wp.array(dtype=wp.vec2d),
     rod_length_in: wp.array(dtype=wp.float64),
     edge_exclusion_in: wp.array(dtype=wp.float64),
+    local_window: wp.float64,
     want_grad: int,
     want_hess: int,
     # Hessian target (want_hess = 1: 144 entries per pair in hess_out; 2: added into the
@@ -356,26 +359,38 @@ def contact_pair_kernel(
     excl = wp.max(edge_exclusion_in[a], edge_exclusion_in[b])
     arc_a = edge_arc_in[a]
     arc_b = edge_arc_in[b]
+    d0 = edge_radius0[a] + edge_radius0[b]
+    core_local = wp.min(core_frac, f64(0.7))
     s_min = f64(1.0e300)
+    local_hit = int(0)
     for gi in range(ng):
         for hi in range(ng):
             xg = gauss_xi[gi]
             xh = gauss_xi[hi]
+            wex = f64(1.0)
+            g_sep = f64(1.0)
             if same != 0:
                 sa = arc_a[0] + xg * (arc_a[1] - arc_a[0])
                 sb = arc_b[0] + xh * (arc_b[1] - arc_b[0])
                 sep = arc_separation(sa, sb, same, rod_closed[ra_], rod_length_in[ra_])
-                if smooth_ramp((sep - excl) / (f64(0.25) * excl))[0] <= f64(0.0):
+                wex = smooth_ramp((sep - excl) / (f64(0.25) * excl))[0]
+                g_sep = wp.sin(wp.min(sep / d0, HALF_PI))
+                if wex <= f64(0.0) and sep < local_window * excl:
                     continue
             r = (xa0 + xg * ea) - (xb0 + xh * eb)
-            s_min = wp.min(s_min, wp.dot(r, r))
-    if s_min >= R * R:
+            ss = wp.dot(r, r)
+            if wex > f64(0.0):
+                s_min = wp.min(s_min, ss)
+            if g_sep < f64(1.0):
+                lim = core_local * g_sep * R
+                if ss < lim * lim:
+                    local_hit = 1
+    if s_min >= R * R and local_hit == 0:
         energy_out[p] = f64(0.0)
         overlap_out[p] = R - wp.sqrt(s_min)
         return
     # Pair constants from the rest diameter D = r_a + r_b and the harmonic-mean modulus:
     # e_line = K_l delta^m_l with K_l = 2 k E D^2 (2D)^-m/m (contact_law), likewise K_p.
-    d0 = edge_radius0[a] + edge_radius0[b]
     emod = f64(2.0) * edge_modulus[a] * edge_modulus[b] / (edge_modulus[a] + edge_modulus[b])
     two_d = f64(2.0) * d0
     K_l = f64(2.0) * law[0] * emod * d0 * d0 * wp.pow(two_d, -m_l) / m_l
@@ -466,21 +481,37 @@ def contact_pair_kernel(
             sa = arc_a[0] + xg * (arc_a[1] - arc_a[0])
             sb = arc_b[0] + xh * (arc_b[1] - arc_b[0])
             sep = arc_separation(sa, sb, same, rod_closed[ra_], rod_length_in[ra_])
-            wex = smooth_ramp((sep - excl) / (f64(0.25) * excl))[0]
-            if same == 0:
-                wex = f64(1.0)
-            if wex <= f64(0.0):
-                continue
+            wex = f64(1.0)
+            g_sep = f64(1.0)
+            if same != 0:
+                wex = smooth_ramp((sep - excl) / (f64(0.25) * excl))[0]
+                g_sep = wp.sin(wp.min(sep / d0, HALF_PI))
+                if wex <= f64(0.0) and sep < local_window * excl:
+                    continue
             r = (xa0 + xg * ea) - (xb0 + xh * eb)
             s = wp.dot(r, r)
             rho = wp.sqrt(s)
-            xmax = wp.max(xmax, R - rho)
+            if wex > f64(0.0):
+                xmax = wp.max(xmax, R - rho)
             if rho >= R:
                 continue
             u = rho / R
-            Fl = scaled_kernel(table_eval(line_table, u0, du, u), rk_l, k_l, R, u)
-            Fp = scaled_kernel(table_eval(point_table, u0, du, u), rk_p, k_p, R, u)
-            hb = hard_core(rho, R, rho_hard, hard_rel, core_frac, kcore)
+            # The law, weighted by the exclusion ramp (zero inside the window).
+            Fl = wp.mat33d()
+            Fp = wp.mat33d()
+            if wex > f64(0.0):
+                Fl = wex * scaled_kernel(table_eval(line_table, u0, du, u), rk_l, k_l, R, u)
+                Fp = wex * scaled_kernel(table_eval(point_table, u0, du, u), rk_p, k_p, R, u)
+            hb = wp.mat33d()
+            if g_sep < f64(1.0):
+                # Local thickness: two points an arc sep apart on a bend of the tightest
+                # legal radius D/2 are a chord D sin(sep/D) apart; closer than core_local
+                # of that (with R for D), the rod folds onto itself inside the exclusion
+                # window, where the law is off. The barrier stops the fold (a tight pull
+                # creased a 125 mm trefoil into a hairpin, legs 0.05 D apart, without it).
+                hb = hard_core(rho, R, rho_hard, f64(0.0), core_local * g_sep, kcore)
+            else:
+                hb = hard_core(rho, R, rho_hard, hard_rel, core_frac, kcore)
             if hb[0, 0] >= f64(1.0e299):
                 # Past the barrier's divergence: an energy no line search accepts, and no
                 # derivatives (they would overflow the assembled matrix).
@@ -490,7 +521,7 @@ def contact_pair_kernel(
             bv = wp.vec3d(hb[0, 0], hb[0, 1] * f64(0.5) / rho,
                           (hb[0, 2] - hb[0, 1] / rho) / (f64(4.0) * s))
             Psi = A * Fl[0, 0] + B * Fp[0, 0] + bv[0]
-            wgt = gauss_w[gi] * gauss_w[hi] * wex
+            wgt = gauss_w[gi] * gauss_w[hi]
             P = la * lb
             energy += wgt * P * Psi
             if want_grad == 0:
