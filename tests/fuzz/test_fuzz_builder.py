@@ -117,10 +117,8 @@ def test_finalize_without_rods_names_the_call() -> None:
         raise AssertionError("finalize() without rods must raise")
 
 
-# -- found by fuzzing, reported to the builder's owner (not fixed here) -----------------------
-@pytest.mark.xfail(strict=True, reason="bug (issue 8 report): D^4 or E I underflows to 0; "
-                   "the builder accepts a rod with zero bending stiffness, and the solver's "
-                   "force scale EI/L^2 is then 0 (residual NaN)")
+# -- found by fuzzing: D^4 or E I underflowed to 0 and the builder accepted a rod with zero
+# bending stiffness (the solver's force scale EI/L^2 was then 0, residual NaN); fixed.
 @pytest.mark.parametrize(("diameter", "youngs_modulus"), [(1e-100, 1.25e6), (1e-3, 1e-320)])
 def test_underflowing_stiffness_is_refused(diameter: float, youngs_modulus: float) -> None:
     pts = np.c_[np.arange(5.0), np.zeros(5), np.zeros(5)] * 0.01

@@ -68,7 +68,7 @@ def test_open_trefoil_parameters(length, d, n, tail) -> None:
     _check_scene(scene)
 
 
-# -- found by fuzzing, reported to the scenes' owner (not fixed here) -------------------------
+# -- found by fuzzing, fixed: each now gives a ValueError naming the parameter ---------------
 KNOWN_BUGS = [
     # (scene, arguments): the error is not a ValueError, or does not name the parameter.
     ("closed", dict(nodes=None)),            # TypeError from int(None)
@@ -81,8 +81,6 @@ KNOWN_BUGS = [
 ]
 
 
-@pytest.mark.xfail(strict=True, reason="bug (issue 8 report): scene argument checks let "
-                   "these through to a deep error")
 @pytest.mark.parametrize(("which", "kw"), KNOWN_BUGS,
                          ids=[f"{w}-{next(iter(k))}={next(iter(k.values()))}"
                               for w, k in KNOWN_BUGS])

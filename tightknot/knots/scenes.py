@@ -115,6 +115,9 @@ def _largest_diameter(points: np.ndarray, closed: bool, diameter: float,
                       clearance: float) -> float:
     """Largest tube diameter [m] that fits on the curve with the margin ``clearance``:
     non-local distance (exclusion window of the target diameter) and bend radius."""
+    if not isinstance(clearance, (int, float, np.floating)) or not (1.0 <= clearance <= 2.0):
+        raise ValueError(f"clearance must be in [1, 2] (a margin on the start's spacing), "
+                         f"got {clearance!r}")
     d, _, _ = curves.min_nonlocal_distance(points, closed,
                                            curves.exclusion_arc_length(diameter))
     kmax = curves.max_curvature(points, closed)
@@ -133,7 +136,11 @@ def _rotate_to_axes(points: np.ndarray, a: int, b: int, c: int) -> np.ndarray:
 
 def _check_common(diameter: float, nodes: int, minimum: int) -> float:
     d0 = check_positive("diameter", diameter, "m")
-    if int(nodes) != nodes or nodes < minimum:
+    if not (1e-9 <= d0 <= 1e3):
+        # Far outside, the curve's scaling to the tube overflows or underflows float64.
+        raise ValueError(f"diameter must be in [1e-9, 1e3] m, got {diameter!r}")
+    if (isinstance(nodes, bool) or not isinstance(nodes, (int, float, np.integer, np.floating))
+            or not math.isfinite(nodes) or int(nodes) != nodes or nodes < minimum):
         raise ValueError(f"nodes must be a whole number >= {minimum}, got {nodes!r}")
     return d0
 
@@ -280,7 +287,8 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
     if l0 < 10.0 * d0:
         raise ValueError(f"rest_length must be >= 10 D0 = {10 * d0:.4g} m for an open knot, "
                          f"got {rest_length!r}")
-    if not (0.05 <= tail_fraction <= 0.45):
+    if not isinstance(tail_fraction, (int, float, np.floating)) or not (
+            0.05 <= tail_fraction <= 0.45):
         raise ValueError(f"tail_fraction must be in [0.05, 0.45], got {tail_fraction!r}")
     # The core of the helper curve is ~26 size units long (trefoil); tails of tail * size each.
     core = curve_fn(4000, 1.0, 0.0)

@@ -26,6 +26,7 @@ from tightknot.knots.scenes import (
     gauge,
     vertex_radii,
 )
+from tightknot.rods.state import State
 from tightknot.solvers.newton import NewtonOptions, newton_solve
 from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord, solve_static
 from tightknot.solvers.system import RodSystem
@@ -45,7 +46,9 @@ class TieResult:
         wall_time_s: wall-clock time [s].
         knot_types: knot type after each converged load step.
         pull_force_N: final pulling force (open knots) [N].
-        system: the last phase's system (its state is the result).
+        system: the last phase's system (its state is the result; after a failed load
+            step, the last equilibrium).
+        failed_state: where the failing load step's solve stopped (None when converged).
     """
 
     converged: bool
@@ -56,6 +59,7 @@ class TieResult:
     knot_types: list[str] = field(default_factory=list)
     pull_force_N: float = 0.0
     system: RodSystem | None = None
+    failed_state: State | None = None
 
 
 def knot_type_of(scene: KnotScene, x: np.ndarray) -> str:
@@ -130,9 +134,10 @@ def tie(
     hold = hold_force_scale * f_unit
     axis = scene.pull_axis if scene.pull_axis is not None else np.zeros(3)
 
-    def fail(msg: str, system: RodSystem | None, force: float) -> TieResult:
+    def fail(msg: str, system: RodSystem | None, force: float,
+             failed_state: State | None = None) -> TieResult:
         return TieResult(False, msg, phases, iters, time.perf_counter() - start, types,
-                         force, system)
+                         force, system, failed_state)
 
     # Phase 1: shrink the rest length from the start to L0.
     shrink = 1.0 / scene.start_length_ratio
@@ -181,7 +186,7 @@ def tie(
     phases["tighten"] = res
     iters += res.newton_iterations
     if not res.converged:
-        return fail(f"tighten: {res.failure}", system, hold)
+        return fail(f"tighten: {res.failure}", system, hold, res.failed_state)
     if scene.closed or (pull_force is None and end_distance is None):
         return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                          hold if not scene.closed else 0.0, system)
@@ -218,7 +223,7 @@ def tie(
         # Reaction at the moved end: the residual force there is the pulling force.
         final_force = end_reaction(system)
     if not res.converged:
-        return fail(f"pull: {res.failure}", system, final_force)
+        return fail(f"pull: {res.failure}", system, final_force, res.failed_state)
     return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                      final_force, system)
 

@@ -85,6 +85,19 @@ class RodBuilder:
         mat = material if material is not None else Material()
         if not isinstance(mat, Material):
             raise ValueError(f"material must be a tightknot.rods.Material, got {type(mat)}")
+        # E I and E A must be positive floats: D^4 or E (D^4) can underflow to 0, and a rod
+        # with no bending stiffness gives the solver a zero force scale (residual NaN).
+        try:
+            emod = float(mat.youngs_modulus)
+        except (TypeError, ValueError):
+            raise ValueError("material.youngs_modulus must be a number [Pa], got "
+                             f"{mat.youngs_modulus!r}") from None
+        ei = emod * second_moment(d0)
+        ea = emod * section_area(d0)
+        if not (math.isfinite(ei) and ei > 0.0 and math.isfinite(ea) and ea > 0.0):
+            raise ValueError(f"diameter {diameter!r} m and youngs_modulus "
+                             f"{mat.youngs_modulus!r} Pa give a bending stiffness E I = {ei!r} "
+                             "N m^2: it must be finite and > 0 (D^4 or E D^4 underflows)")
         closed = bool(closed)
         with np.errstate(over="ignore", invalid="ignore"):
             edges = np.diff(np.vstack([pts, pts[:1]]) if closed else pts, axis=0)
