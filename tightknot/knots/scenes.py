@@ -111,6 +111,10 @@ class KnotScene:
     info: dict = field(default_factory=dict)
 
 
+#: Points of the start curve used to measure its spacing (see _largest_diameter).
+_SPACING_POINTS = 4000
+
+
 def _largest_diameter(points: np.ndarray, closed: bool, diameter: float,
                       clearance: float) -> float:
     """Largest tube diameter [m] that fits on the curve with the margin ``clearance``:
@@ -118,6 +122,11 @@ def _largest_diameter(points: np.ndarray, closed: bool, diameter: float,
     if not isinstance(clearance, (int, float, np.floating)) or not (1.0 <= clearance <= 2.0):
         raise ValueError(f"clearance must be in [1, 2] (a margin on the start's spacing), "
                          f"got {clearance!r}")
+    if points.shape[0] > _SPACING_POINTS:
+        # The start curve is smooth: a 4000-point resampling gives its spacing to the sag of
+        # its chords (far inside the clearance), whereas the KD-tree pairs of a 1e5-vertex
+        # polygon within one exclusion window (~1e9) do not fit in memory.
+        points = curves.resample_uniform(points, _SPACING_POINTS, closed)
     d, _, _ = curves.min_nonlocal_distance(points, closed,
                                            curves.exclusion_arc_length(diameter))
     kmax = curves.max_curvature(points, closed)

@@ -46,6 +46,14 @@ _GAUSS = {
 _MARGIN = 1.1
 
 
+#: Most candidate edge pairs the broad phase may return (about 0.5 GB of pair data).
+MAX_CANDIDATES = 20_000_000
+
+
+class ContactCapacityError(ValueError):
+    """More candidate contact pairs than memory allows (too fine a mesh for the contact)."""
+
+
 class SelfIntersectionError(ValueError):
     """The rods already pass through each other (closer than the hard limit)."""
 
@@ -243,6 +251,15 @@ class ContactLayer:
             n = int(self._count.numpy()[0])
             if n <= self._capacity:
                 return self._pairs[:n]
+            if n > MAX_CANDIDATES:
+                # Pairs per contact grow as (D/l)^2: a fine mesh of a knot whose strands
+                # touch over many diameters outgrows memory (measured: 1.9e6 candidates for
+                # a trefoil of 1e4 vertices, about 2e8 at 1e5, where memory ran out).
+                raise ContactCapacityError(
+                    f"{n} candidate contact pairs exceed the limit {MAX_CANDIDATES}: "
+                    f"{m.vertex_count} vertices are too many for this contact set (edges of "
+                    f"{np.median(self.model.edge_rest_length) / np.median(self.edge_diameter):.2g}"
+                    " D); use fewer nodes (pairs grow as the square of the vertex count)")
             # Overflow: grow and query again, never drop a candidate.
             self._capacity = int(2 ** math.ceil(math.log2(n * 1.25)))
             self._alloc(self._capacity)
