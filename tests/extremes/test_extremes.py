@@ -276,11 +276,9 @@ def test_failed_cli_run_writes_its_summary_and_exits_1(tmp_path) -> None:
     assert C.all_finite(s)
 
 
-# -- found here, reported to the contact layer's owner (not fixed here) ------------------------
-@pytest.mark.xfail(strict=True, reason="bug (issue 8 report): ContactLayer.min_distance "
-                   "measures whole segments of pairs with only some points beyond the "
-                   "exclusion window, so on coarse meshes it reports neighbouring edges of "
-                   "one strand (0.63 D0 where the strands are 0.998 D0 apart)")
+# -- found here: ContactLayer.min_distance measured whole segments of pairs with only some
+# points beyond the exclusion window, so on coarse meshes it reported neighbouring edges of
+# one strand (0.63 D0 where the strands are 0.998 D0 apart); fixed (_beyond_window).
 def test_min_gap_is_a_nonlocal_distance_on_a_coarse_mesh() -> None:
     # Loose closed trefoil (L0/D0 = 40) at 64 vertices (edges 0.63 D0): the summary's
     # min_gap_over_D0 comes from ContactLayer.min_distance. The vertex-to-vertex distance
