@@ -13,7 +13,6 @@ from typing import Any
 
 import numpy as np
 
-from tightknot.knots import figures
 from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal import load_ideal_trefoil
 from tightknot.knots.measure import analyze_centerline
@@ -261,9 +260,12 @@ def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> 
     ``tube``: also draw each run's final rod as a tube coloured by this field
     (``tube_<field>.png``; ``<i>_tube_<field>.png`` for several runs).
     """
+    # matplotlib only here: importing it costs 1.5-2 s in every fresh sweep worker.
     import matplotlib
 
     matplotlib.use("Agg")
+    from tightknot.knots import figures
+
     folder.mkdir(parents=True, exist_ok=True)
     paths: list[Path] = []
     if tube is not None:
