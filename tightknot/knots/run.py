@@ -6,6 +6,7 @@ same keys (the knots issue's JSON summary).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -147,7 +148,9 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         "rest_length_m": scene.rest_length,
         "stretch": rep["stretch_L_over_L0"],
         "L_over_D": rep["L_over_D"],
-        "min_gap_over_D0": dmin / scene.diameter,
+        # No pair within the interaction range (a knot that came undone): no gap to report
+        # (JSON has no infinity).
+        "min_gap_over_D0": dmin / scene.diameter if math.isfinite(dmin) else None,
         "max_pressure_over_E": float(np.max(contact.peak_pressure_over_E)),
         "min_area_ratio": float(np.min(contact.area_ratio)),
         "max_contact_width_fraction": float(np.max(contact.contact_width_fraction)),

@@ -155,8 +155,10 @@ def _line(record: dict[str, Any], label: str) -> str:
             head += (f"\n    {row['kind']} {row['target']:g}: force {row['pull_force_N']:.4g} N,"
                      f" Lambda_OC {lam}{mark}")
     elif "L_over_D" in res:
+        gap = res.get("min_gap_over_D0")
+        gap_s = "-" if gap is None else f"{gap:.4f}"  # None: no pair in range (knot undone)
         head += (f"\n    L/D {res['L_over_D']:.4f}, stretch {res['stretch']:.4f}, min gap/D0 "
-                 f"{res['min_gap_over_D0']:.4f}, kappa D0 max {res['kappa_D0_max']:.3f}")
+                 f"{gap_s}, kappa D0 max {res['kappa_D0_max']:.3f}")
     return head
 
 
