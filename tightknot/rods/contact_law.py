@@ -50,13 +50,19 @@ x = 0.01 D).
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import hashlib
+import inspect
 import json
 import math
+import os
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
+
+from tightknot.atomic import atomic_open
 
 _LAW_FILE = Path(__file__).resolve().parents[1] / "data" / "contact_law.json"
 
@@ -247,8 +253,51 @@ def abel_line_profile(m: float, u: np.ndarray) -> np.ndarray:
     return 0.5 * tmax * (f * wg[None, :]).sum(axis=1)
 
 
+def _table_cache_dir() -> Path | None:
+    """Folder of the on-disk kernel tables: $TIGHTKNOT_CACHE, else a ``tightknot`` folder in
+    Warp's kernel cache ($WARP_CACHE_PATH, which the Makefile and tests set); None (no disk
+    cache) when neither is set."""
+    root = os.environ.get("TIGHTKNOT_CACHE")
+    if root:
+        return Path(root)
+    warp_cache = os.environ.get("WARP_CACHE_PATH")
+    return Path(warp_cache) / "tightknot" if warp_cache else None
+
+
+def _table_key(kind: str, m: float, band: float) -> str:
+    """Cache key: the arguments exactly (float.hex), the table size, and a hash of the code
+    that computes the table (so a changed formula never reads an old file)."""
+    code = inspect.getsource(_kernel_table) + inspect.getsource(abel_line_profile) + (
+        inspect.getsource(_ramp))
+    text = f"{kind}|{float(m).hex()}|{float(band).hex()}|{U_MIN!r}|{TABLE_INTERVALS}|{code}"
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
 @functools.lru_cache(maxsize=16)
 def kernel_table(kind: str, m: float, band: float = TABLE_BAND) -> np.ndarray:
+    """The table of :func:`_kernel_table`, cached in memory and on disk (computing the line
+    kernel's Abel integrals takes about a second, paid once per machine instead of once per
+    process: sweep workers and CLI runs start faster). A cached file is used only if it
+    loads as an array of the right shape with finite values; it is written atomically."""
+    folder = _table_cache_dir()
+    path = None if folder is None else folder / f"kernel_{kind}_{_table_key(kind, m, band)}.npy"
+    if path is not None and path.is_file():
+        try:
+            table = np.load(path, allow_pickle=False)
+            if table.shape == (TABLE_INTERVALS, 4) and np.isfinite(table).all():
+                return table
+        except (OSError, ValueError):
+            pass  # unreadable or truncated: compute it again and replace it
+    table = _kernel_table(kind, m, band)
+    if path is not None:
+        with contextlib.suppress(OSError):  # a read-only cache only costs the speed-up
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_open(path, "wb") as handle:
+                np.save(handle, table, allow_pickle=False)
+    return table
+
+
+def _kernel_table(kind: str, m: float, band: float = TABLE_BAND) -> np.ndarray:
     """Cubic-spline coefficients (TABLE_INTERVALS, 4) of the dimensionless kernel T(u):
     line: T = Phi_m(u) (kernel (K m/pi) R^(m-1) T(rho/R)); point: T = (1-u)^(m-1)/u (kernel
     K m/(2 pi) R^(m-2) T). T is taken at 1 - h(1 - u - b), h the C2 ramp of band b
