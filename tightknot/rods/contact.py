@@ -414,18 +414,24 @@ class ContactLayer:
                 f"{d[k]:.4g} m apart, below the hard limit {hard[k]:.4g} m "
                 f"({self.hard_fraction:g} D)")
 
-    def _nonlocal(self, pr: np.ndarray, ar: np.ndarray) -> np.ndarray:
-        """Mask of the pairs that hold two points farther apart along the rod than the
-        exclusion window (the candidates also hold closer pairs, for the local barrier)."""
+    def _window_separations(self, pr: np.ndarray, ar: np.ndarray) -> tuple[np.ndarray, ...]:
+        """For edge pairs ``pr`` with rest arcs ``ar``: whether both edges lie on one rod,
+        the rest arc separations of their four end pairs (the shorter way round on a closed
+        rod), each pair's rod length and closure, and its exclusion window."""
         m = self.model
         rod = m.edge_rod[pr]
-        same = rod[:, 0] == rod[:, 1]
         a, b = ar[pr[:, 0]], ar[pr[:, 1]]
         seps = np.abs(a[:, :, None] - b[:, None, :]).reshape(-1, 4)
         length = np.array([ar[r.edge_slice][-1, 1] for r in m.rods])[rod[:, 0]]
         closed = np.array([r.closed for r in m.rods])[rod[:, 0]]
         seps = np.where(closed[:, None], np.minimum(seps, length[:, None] - seps), seps)
         excl = np.maximum(self.exclusion[pr[:, 0]], self.exclusion[pr[:, 1]])
+        return rod[:, 0] == rod[:, 1], seps, length, closed, excl
+
+    def _nonlocal(self, pr: np.ndarray, ar: np.ndarray) -> np.ndarray:
+        """Mask of the pairs that hold two points farther apart along the rod than the
+        exclusion window (the candidates also hold closer pairs, for the local barrier)."""
+        same, seps, _, _, excl = self._window_separations(pr, ar)
         return ~same | (seps.max(axis=1) >= excl)
 
     def _beyond_window(self, x: np.ndarray, pr: np.ndarray, d: np.ndarray,
@@ -436,14 +442,9 @@ class ContactLayer:
         of a tight bend's neighbouring points on a coarse mesh (a loose 40 D0 trefoil at 64
         vertices reported 0.63 D0 where its strands are 0.998 D0 apart)."""
         m = self.model
-        rod = m.edge_rod[pr]
+        same, seps, length, closed, excl = self._window_separations(pr, ar)
         a, b = ar[pr[:, 0]], ar[pr[:, 1]]
-        seps = np.abs(a[:, :, None] - b[:, None, :]).reshape(-1, 4)
-        length = np.array([ar[r.edge_slice][-1, 1] for r in m.rods])[rod[:, 0]]
-        closed = np.array([r.closed for r in m.rods])[rod[:, 0]]
-        seps = np.where(closed[:, None], np.minimum(seps, length[:, None] - seps), seps)
-        excl = np.maximum(self.exclusion[pr[:, 0]], self.exclusion[pr[:, 1]])
-        partial = np.flatnonzero((rod[:, 0] == rod[:, 1]) & (seps.min(axis=1) < excl))
+        partial = np.flatnonzero(same & (seps.min(axis=1) < excl))
         if not partial.size:
             return d
         d = d.copy()
