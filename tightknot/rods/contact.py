@@ -209,6 +209,7 @@ class ContactLayer:
         self.rest = model.edge_rest_length.copy()
         # Placeholders for the kernel's unused Hessian targets.
         self._no_tables = (wp.full(1, -1, dtype=wp.int64, device=dev),
+                           wp.zeros(model.vertex_count + 1, dtype=wp.int32, device=dev),
                            wp.full(1, wp.vec3i(-1, -1, -1), dtype=wp.vec3i, device=dev),
                            wp.full(model.vertex_count, wp.vec3i(-1, -1, -1), dtype=wp.vec3i,
                                    device=dev))
@@ -266,7 +267,7 @@ class ContactLayer:
 
     # -- the energy term -------------------------------------------------------------------
     def _launch(self, x: np.ndarray, rest: np.ndarray, want_grad: bool, hess_mode: int,
-                tables: tuple[wp.array, wp.array, wp.array] | None = None,
+                tables: tuple[wp.array, ...] | None = None,
                 csc: wp.array | None = None) -> tuple:
         """Detect and evaluate every candidate pair; hess_mode 0 none, 1 per-pair 144
         entries, 2 added into the CSC data ``csc`` through the block ``tables``."""

@@ -136,15 +136,19 @@ def outer33(a: wp.vec3d, b: wp.vec3d) -> wp.mat33d:
 
 
 @wp.func
-def block(Fzz: wp.mat44d, ga0: wp.vec3d, ga1: wp.vec3d, ga2: wp.vec3d, ga3: wp.vec3d,
-          gb0: wp.vec3d, gb1: wp.vec3d, gb2: wp.vec3d, gb3: wp.vec3d) -> wp.mat33d:
-    """sum_kl Fzz[k, l] outer(ga_k, gb_l): the Gauss-Newton part of a Y-space block."""
-    m = wp.mat33d()
-    m = m + outer33(ga0, Fzz[0, 0] * gb0 + Fzz[0, 1] * gb1 + Fzz[0, 2] * gb2 + Fzz[0, 3] * gb3)
-    m = m + outer33(ga1, Fzz[1, 0] * gb0 + Fzz[1, 1] * gb1 + Fzz[1, 2] * gb2 + Fzz[1, 3] * gb3)
-    m = m + outer33(ga2, Fzz[2, 0] * gb0 + Fzz[2, 1] * gb1 + Fzz[2, 2] * gb2 + Fzz[2, 3] * gb3)
-    m = m + outer33(ga3, Fzz[3, 0] * gb0 + Fzz[3, 1] * gb1 + Fzz[3, 2] * gb2 + Fzz[3, 3] * gb3)
-    return m
+def rank1_pair(u: wp.vec3d, fu: wp.float64, fv: wp.float64, a: wp.vec3d, v: wp.vec3d
+               ) -> wp.mat33d:
+    """outer(u, fu a + fv v): a Y-space block sum_kl Fzz[k, l] outer(g_k, g_l) with one
+    nonzero z-gradient g on the left (``u``) and two on the right (``a``, ``v``)."""
+    return outer33(u, fu * a + fv * v)
+
+
+@wp.func
+def rank2_pair(u1: wp.vec3d, u3: wp.vec3d, f11: wp.float64, f13: wp.float64,
+               f31: wp.float64, f33: wp.float64, a: wp.vec3d, v: wp.vec3d) -> wp.mat33d:
+    """outer(u1, f11 a + f13 v) + outer(u3, f31 a + f33 v): a Y-space block with two
+    nonzero z-gradients on each side."""
+    return outer33(u1, f11 * a + f13 * v) + outer33(u3, f31 * a + f33 * v)
 
 
 @wp.func
@@ -155,36 +159,40 @@ def set_hess(out: wp.array(dtype=wp.float64), base: int, v: int, w: int, m: wp.m
 
 
 @wp.func
-def find_key(keys: wp.array(dtype=wp.int64), key: wp.int64) -> int:
-    """Index of ``key`` in the sorted array ``keys``, -1 if absent (binary search)."""
-    lo = int(0)
-    hi = keys.shape[0]
-    while lo < hi:
-        mid = (lo + hi) // 2
+def find_key(keys: wp.array(dtype=wp.int64), key: wp.int64, lo: int, hi: int) -> int:
+    """Index of ``key`` in the sorted array ``keys`` within [lo, hi), -1 if absent (binary
+    search)."""
+    a = int(lo)
+    b = int(hi)
+    while a < b:
+        mid = (a + b) // 2
         if keys[mid] < key:
-            lo = mid + 1
+            a = mid + 1
         else:
-            hi = mid
-    if lo < keys.shape[0]:
-        if keys[lo] == key:
-            return lo
+            b = mid
+    if a < hi:
+        if keys[a] == key:
+            return a
     return -1
 
 
 @wp.func
-def scatter_block(block_keys: wp.array(dtype=wp.int64), block_cols: wp.array(dtype=wp.vec3i),
-                  vertex_rank: wp.array(dtype=wp.vec3i), vr: int, vc: int, m: wp.mat33d,
-                  csc_out: wp.array(dtype=wp.float64), missing_out: wp.array(dtype=wp.int32)):
+def scatter_block(block_keys: wp.array(dtype=wp.int64), block_rows: wp.array(dtype=wp.int32),
+                  block_cols: wp.array(dtype=wp.vec3i), vertex_rank: wp.array(dtype=wp.vec3i),
+                  vr: int, vc: int, m: wp.mat33d, csc_out: wp.array(dtype=wp.float64),
+                  missing_out: wp.array(dtype=wp.int32)):
     """Add the 3 x 3 block of vertex rows ``vr``, columns ``vc`` into the CSC data.
 
     Block table (tightknot.solvers.contact_pattern): key vr * V + vc; block_cols[k][j] is
     the data slot of the first free row of vr in the column of component j of vc (-1 if
     that component is fixed); vertex_rank[vr][i] the offset of component i among the free
     components of vr (-1 if fixed): the free rows of one vertex are consecutive in a
-    column. A block missing from the table is counted in ``missing_out`` (the caller
-    grows the pattern and evaluates again)."""
+    column; block_rows[vr] .. block_rows[vr + 1] the range of row vr's keys (the search
+    stays in one row: a few dozen keys, not the whole table). A block missing from the
+    table is counted in ``missing_out`` (the caller grows the pattern and evaluates
+    again)."""
     key = wp.int64(vr) * wp.int64(vertex_rank.shape[0]) + wp.int64(vc)
-    k = find_key(block_keys, key)
+    k = find_key(block_keys, key, block_rows[vr], block_rows[vr + 1])
     if k < 0:
         wp.atomic_add(missing_out, 0, 1)
         return
@@ -195,6 +203,26 @@ def scatter_block(block_keys: wp.array(dtype=wp.int64), block_cols: wp.array(dty
             for i in range(3):
                 if rank[i] >= 0:
                     wp.atomic_add(csc_out, cols[j] + rank[i], m[i, j])
+
+
+@wp.func
+def put_block(want_hess: int, hess_out: wp.array(dtype=wp.float64), base: int,
+              block_keys: wp.array(dtype=wp.int64), block_rows: wp.array(dtype=wp.int32),
+              block_cols: wp.array(dtype=wp.vec3i), vertex_rank: wp.array(dtype=wp.vec3i),
+              csc_out: wp.array(dtype=wp.float64), missing_out: wp.array(dtype=wp.int32),
+              verts: wp.vec4i, v: int, w: int, m: wp.mat33d):
+    """Store the pair's vertex block (v, w) and, off the diagonal, its transpose (w, v):
+    into the 144 per-pair entries (want_hess 1) or the CSC data (2)."""
+    if want_hess == 1:
+        set_hess(hess_out, base, v, w, m)
+        if w != v:
+            set_hess(hess_out, base, w, v, wp.transpose(m))
+    else:
+        scatter_block(block_keys, block_rows, block_cols, vertex_rank, verts[v], verts[w], m,
+                      csc_out, missing_out)
+        if w != v:
+            scatter_block(block_keys, block_rows, block_cols, vertex_rank, verts[w], verts[v],
+                          wp.transpose(m), csc_out, missing_out)
 
 
 @wp.kernel
@@ -305,6 +333,7 @@ def contact_pair_kernel(
     # Hessian target (want_hess = 1: 144 entries per pair in hess_out; 2: added into the
     # CSC data array csc_out through the block table, see scatter_block):
     block_keys: wp.array(dtype=wp.int64),
+    block_rows: wp.array(dtype=wp.int32),
     block_cols: wp.array(dtype=wp.vec3i),
     vertex_rank: wp.array(dtype=wp.vec3i),
     # Out:
@@ -473,7 +502,32 @@ def contact_pair_kernel(
     Sab = wp.mat33d()
     any_hess = int(0)
     xmax = f64(-1.0e30)
-    zero3 = wp.vec3d()
+    # Second derivatives of q = c^2, constants of the pair (the Hessian of c: see module
+    # docstring); computed once here, used by every Gauss pair.
+    eye = wp.identity(n=3, dtype=wp.float64)
+    Pa = eye - outer33(ta, ta)
+    Pb = eye - outer33(tb, tb)
+    Hq_aa = wp.mat33d()
+    Hq_bb = wp.mat33d()
+    Hq_ab = wp.mat33d()
+    if want_hess != 0:
+        ua = tb - c * ta
+        ub = ta - c * tb
+        Hc_aa = (-(outer33(ua, ta) + outer33(ta, ua)) - c * Pa) / (la * la)
+        Hc_bb = (-(outer33(ub, tb) + outer33(tb, ub)) - c * Pb) / (lb * lb)
+        Hc_ab = (Pb - outer33(ta, ub)) / (la * lb)
+        Hq_aa = f64(2.0) * (outer33(dc_a, dc_a) + c * Hc_aa)
+        Hq_bb = f64(2.0) * (outer33(dc_b, dc_b) + c * Hc_bb)
+        Hq_ab = f64(2.0) * (outer33(dc_a, dc_b) + c * Hc_ab)
+    # Which laws the blend uses (its weights and their derivatives in q exactly zero
+    # otherwise): near-parallel pairs need only the line law, crossing pairs only the
+    # point law; skipping a law whose every weight is zero changes no bit of the sums.
+    use_line = int(1)
+    if A == f64(0.0) and A1 == f64(0.0) and A2 == f64(0.0):
+        use_line = 0
+    use_point = int(0)
+    if xi > f64(0.0):
+        use_point = 1
     for gi in range(ng):
         for hi in range(ng):
             xg = gauss_xi[gi]
@@ -500,8 +554,12 @@ def contact_pair_kernel(
             Fl = wp.mat33d()
             Fp = wp.mat33d()
             if wex > f64(0.0):
-                Fl = wex * scaled_kernel(table_eval(line_table, u0, du, u), rk_l, k_l, R, u)
-                Fp = wex * scaled_kernel(table_eval(point_table, u0, du, u), rk_p, k_p, R, u)
+                if use_line != 0:
+                    Fl = wex * scaled_kernel(table_eval(line_table, u0, du, u), rk_l, k_l, R,
+                                             u)
+                if use_point != 0:
+                    Fp = wex * scaled_kernel(table_eval(point_table, u0, du, u), rk_p, k_p,
+                                             R, u)
             hb = wp.mat33d()
             if g_sep < f64(1.0):
                 # Local thickness: two points an arc sep apart on a bend of the tightest
@@ -571,27 +629,17 @@ def contact_pair_kernel(
             Fzz = wgt * (P * Pzz + wp.outer(Pp, Pz) + wp.outer(Pz, Pp))
             Fzz[1, 2] = Fzz[1, 2] + wgt * Psi
             Fzz[2, 1] = Fzz[2, 1] + wgt * Psi
-            eye = wp.identity(n=3, dtype=wp.float64)
-            Hrr = block(Fzz, gr_s, zero3, zero3, zero3, gr_s, zero3, zero3, zero3) + (
-                f64(2.0) * Fz[0]) * eye
-            Hra = block(Fzz, gr_s, zero3, zero3, zero3, zero3, ga_la, zero3, dq_a)
-            Hrb = block(Fzz, gr_s, zero3, zero3, zero3, zero3, zero3, gb_lb, dq_b)
-            # Second derivatives of q = c^2 (the Hessian of c: see module docstring).
-            ua = tb - c * ta
-            ub = ta - c * tb
-            Pa = eye - outer33(ta, ta)
-            Pb = eye - outer33(tb, tb)
-            Hc_aa = (-(outer33(ua, ta) + outer33(ta, ua)) - c * Pa) / (la * la)
-            Hc_bb = (-(outer33(ub, tb) + outer33(tb, ub)) - c * Pb) / (lb * lb)
-            Hc_ab = (Pb - outer33(ta, ub)) / (la * lb)
-            Hq_aa = f64(2.0) * (outer33(dc_a, dc_a) + c * Hc_aa)
-            Hq_bb = f64(2.0) * (outer33(dc_b, dc_b) + c * Hc_bb)
-            Hq_ab = f64(2.0) * (outer33(dc_a, dc_b) + c * Hc_ab)
-            Haa = block(Fzz, zero3, ga_la, zero3, dq_a, zero3, ga_la, zero3, dq_a) + (
-                Fz[1] / la) * Pa + Fz[3] * Hq_aa
-            Hbb = block(Fzz, zero3, zero3, gb_lb, dq_b, zero3, zero3, gb_lb, dq_b) + (
-                Fz[2] / lb) * Pb + Fz[3] * Hq_bb
-            Hab = block(Fzz, zero3, ga_la, zero3, dq_a, zero3, zero3, gb_lb, dq_b) + Fz[3] * Hq_ab
+            # The Y-space blocks sum_kl Fzz[k, l] outer(g_k, g_l) over the z-gradients of
+            # the blocks' variables (r: only s; e_a: l_a and q; e_b: l_b and q).
+            Hrr = outer33(gr_s, Fzz[0, 0] * gr_s) + (f64(2.0) * Fz[0]) * eye
+            Hra = rank1_pair(gr_s, Fzz[0, 1], Fzz[0, 3], ga_la, dq_a)
+            Hrb = rank1_pair(gr_s, Fzz[0, 2], Fzz[0, 3], gb_lb, dq_b)
+            Haa = rank2_pair(ga_la, dq_a, Fzz[1, 1], Fzz[1, 3], Fzz[3, 1], Fzz[3, 3], ga_la,
+                             dq_a) + (Fz[1] / la) * Pa + Fz[3] * Hq_aa
+            Hbb = rank2_pair(gb_lb, dq_b, Fzz[2, 2], Fzz[2, 3], Fzz[3, 2], Fzz[3, 3], gb_lb,
+                             dq_b) + (Fz[2] / lb) * Pb + Fz[3] * Hq_bb
+            Hab = rank2_pair(ga_la, dq_a, Fzz[1, 2], Fzz[1, 3], Fzz[3, 2], Fzz[3, 3], gb_lb,
+                             dq_b) + Fz[3] * Hq_ab
             # Accumulate; the map to the vertices is linear in (xg, xh), done once below.
             any_hess = 1
             M0 = M0 + Hrr
@@ -612,36 +660,55 @@ def contact_pair_kernel(
     if want_hess != 0 and any_hess != 0:
         # Vertex blocks H_vw = sum_gh C_v^T H_Y C_w with the coefficients of (r, e_a, e_b)
         # in vertex v: c_r = alpha_v + beta_v xg + gamma_v xh (r = (1-xg) xa0 + xg xa1
-        # - (1-xh) xb0 - xh xb1), c_a = (-1, 1, 0, 0), c_b = (0, 0, -1, 1).
-        al = wp.vec4d(f64(1.0), f64(0.0), f64(-1.0), f64(0.0))
-        be = wp.vec4d(f64(-1.0), f64(1.0), f64(0.0), f64(0.0))
-        ga = wp.vec4d(f64(0.0), f64(0.0), f64(1.0), f64(-1.0))
-        ca = wp.vec4d(f64(-1.0), f64(1.0), f64(0.0), f64(0.0))
-        cb = wp.vec4d(f64(0.0), f64(0.0), f64(-1.0), f64(1.0))
+        # - (1-xh) xb0 - xh xb1: alpha = (1, 0, -1, 0), beta = (-1, 1, 0, 0), gamma =
+        # (0, 0, 1, -1)), c_a = (-1, 1, 0, 0), c_b = (0, 0, -1, 1). Written out with the
+        # zero coefficients dropped (the moments' sums are linear in the coefficients; the
+        # order of the remaining terms is that of the generic sum
+        # (alpha alpha) M0 + (alpha beta + beta alpha) Mg + (alpha gamma + gamma alpha) Mh
+        # + (beta beta) Mgg + (gamma gamma) Mhh + (beta gamma + gamma beta) Mgh
+        # + c_a,w Ra_v + c_b,w Rb_v + c_a,v Ra_w^T + c_b,v Rb_w^T
+        # + c_a,v c_a,w Saa + c_b,v c_b,w Sbb + c_a,v c_b,w Sab + c_b,v c_a,w Sab^T,
+        # with Ra_v = sum c_r,v H_ra, Rb_v = sum c_r,v H_rb).
+        # (a + (-1) b is a - b exactly, and -a + b is b - a: the same bits as the sum.)
+        Ra0 = A0 - Ag
+        Rb0 = B0 - Bg
+        Ra1 = Ag
+        Rb1 = Bg
+        Ra2 = Ah - A0
+        Rb2 = Bh - B0
+        Ra3 = -Ah
+        Rb3 = -Bh
+        m00 = M0 - f64(2.0) * Mg + Mgg - Ra0 - wp.transpose(Ra0) + Saa
+        m01 = Mg - Mgg + Ra0 - wp.transpose(Ra1) - Saa
+        m02 = Mg - M0 + Mh - Mgh - Rb0 - wp.transpose(Ra2) + Sab
+        m03 = Mgh - Mh + Rb0 - wp.transpose(Ra3) - Sab
+        m11 = Mgg + Ra1 + wp.transpose(Ra1) + Saa
+        m12 = Mgh - Mg - Rb1 + wp.transpose(Ra2) - Sab
+        m13 = Rb1 - Mgh + wp.transpose(Ra3) + Sab
+        m22 = M0 - f64(2.0) * Mh + Mhh - Rb2 - wp.transpose(Rb2) + Sbb
+        m23 = Mh - Mhh + Rb2 - wp.transpose(Rb3) - Sbb
+        m33 = Mhh + Rb3 + wp.transpose(Rb3) + Sbb
         verts = wp.vec4i(va[0], va[1], vb[0], vb[1])
-        for v in range(4):
-            Ra_v = al[v] * A0 + be[v] * Ag + ga[v] * Ah  # sum c_r,v H_ra
-            Rb_v = al[v] * B0 + be[v] * Bg + ga[v] * Bh  # sum c_r,v H_rb
-            for w in range(v, 4):
-                Ra_w = al[w] * A0 + be[w] * Ag + ga[w] * Ah
-                Rb_w = al[w] * B0 + be[w] * Bg + ga[w] * Bh
-                m = (al[v] * al[w]) * M0 + (al[v] * be[w] + be[v] * al[w]) * Mg
-                m = m + (al[v] * ga[w] + ga[v] * al[w]) * Mh + (be[v] * be[w]) * Mgg
-                m = m + (ga[v] * ga[w]) * Mhh + (be[v] * ga[w] + ga[v] * be[w]) * Mgh
-                m = m + ca[w] * Ra_v + cb[w] * Rb_v
-                m = m + ca[v] * wp.transpose(Ra_w) + cb[v] * wp.transpose(Rb_w)
-                m = m + (ca[v] * ca[w]) * Saa + (cb[v] * cb[w]) * Sbb
-                m = m + (ca[v] * cb[w]) * Sab + (cb[v] * ca[w]) * wp.transpose(Sab)
-                if want_hess == 1:
-                    set_hess(hess_out, base, v, w, m)
-                    if w != v:
-                        set_hess(hess_out, base, w, v, wp.transpose(m))
-                else:
-                    scatter_block(block_keys, block_cols, vertex_rank, verts[v], verts[w], m,
-                                  csc_out, missing_out)
-                    if w != v:
-                        scatter_block(block_keys, block_cols, vertex_rank, verts[w], verts[v],
-                                      wp.transpose(m), csc_out, missing_out)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 0, 0, m00)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 0, 1, m01)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 0, 2, m02)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 0, 3, m03)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 1, 1, m11)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 1, 2, m12)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 1, 3, m13)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 2, 2, m22)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 2, 3, m23)
+        put_block(want_hess, hess_out, base, block_keys, block_rows, block_cols, vertex_rank,
+                  csc_out, missing_out, verts, 3, 3, m33)
     energy_out[p] = energy
     overlap_out[p] = xmax
     if want_grad != 0:

@@ -110,12 +110,16 @@ class ContactPattern:
     # -- kernel arguments and matrices -------------------------------------------------
     _warp: tuple[wp.array, wp.array, wp.array] | None = None
 
-    def warp_tables(self, device: str) -> tuple[wp.array, wp.array, wp.array]:
-        """The block table as Warp arrays (keys, cols, vertex ranks), cached."""
+    def warp_tables(self, device: str) -> tuple[wp.array, ...]:
+        """The block table as Warp arrays (keys, row ranges, cols, vertex ranks), cached;
+        row vr's keys are keys[rows[vr]:rows[vr + 1]]."""
         if self._warp is None:
             keys = self.block_keys if self.block_keys.size else np.full(1, -1, np.int64)
             cols = self.block_cols if self.block_cols.size else np.full((1, 3), -1, np.int32)
+            nv = self.vertex_rank.shape[0]
+            rows = np.searchsorted(self.block_keys, np.arange(nv + 1, dtype=np.int64) * nv)
             self._warp = (wp.array(keys, dtype=wp.int64, device=device),
+                          wp.array(rows.astype(np.int32), dtype=wp.int32, device=device),
                           wp.array(np.ascontiguousarray(cols), dtype=wp.vec3i, device=device),
                           wp.array(self.vertex_rank, dtype=wp.vec3i, device=device))
         return self._warp
