@@ -1,25 +1,23 @@
-"""Many independent closed knots tied together: one model, one Newton loop, one set of launches.
+"""Many independent closed knots tied together: one model, one set of Warp launches.
 
 A sweep of small cases pays, per case and per Newton iteration, a fixed cost for every
-Warp launch, BVH build, sparse factorization and Python step. Putting the rods of many
-cases into one :class:`~tightknot.rods.model.Model` (the builder lays them out one after
-another, every array carries a rod index) pays that cost once per iteration for all. On
-the CPU it buys little (``tightknot bench batch``, 100-vertex trefoils: the evaluation per
-rod falls from 1.8 to 0.95 ms, the factorization stays 1.5 ms per rod, and the joint loop
-needs more iterations than one rod); the launches are where a GPU gains.
+Warp launch, BVH build and Python step. Putting the rods of many cases into one
+:class:`~tightknot.rods.model.Model` (the builder lays them out one after another, every
+array carries a rod index) pays the launches once per round for all rods.
 
 The copies are placed far apart in space (a grid with a gap of many diameters between
 their bounding boxes), so the contact layer, which also handles rod-rod contact, never
-finds a pair between two copies: the joint system is block diagonal and each block is the
-single case's. The tie follows :func:`tightknot.knots.tie.tie` (same continuation
-settings, same self-similar predictor, same knot-type check after every step), except
-that the load parameter, the Newton step length and the damping are shared: a step is
-accepted only when every rod converged, and the line search takes the shortest step any
-rod allows. Each rod then ends at an equilibrium of its own case to the same residual
-tolerance, but along another path than its own tie: where the path can fork, it may be
-another equilibrium than the one tie() finds, e.g. the same closed knot shifted along its
-rod (measured: 1 of 16 identical trefoils 0.19 D0 off in positions, 3e-5 in the
-curvature profile at the best shift).
+finds a pair between two copies: the rods are independent. Each rod runs the closed-knot
+path of :func:`tightknot.knots.tie.tie` with its own solver state
+(:mod:`tightknot.knots.batch_newton`: its own load parameter and step, Newton shift, line
+search and convergence test, and the same knot-type check after every load step); all
+rods' questions about their potentials are answered together by one evaluation
+(:mod:`tightknot.knots.batch_eval`). Each rod thus follows its own tie's path up to
+round-off (the joint evaluation sums in another order; the Newton systems are solved by a
+banded Cholesky factorization, :mod:`tightknot.knots.batch_linear`). Where a path is close
+to a fork, round-off can still lead a rod to another equilibrium than its tie's, e.g. the
+same closed knot shifted along its rod; ``tightknot bench batch`` reports each case's
+difference.
 """
 
 from __future__ import annotations
@@ -30,16 +28,29 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tightknot.knots.scenes import KnotScene
+from tightknot.knots.batch_eval import (
+    BatchContactLayer,
+    BatchEvaluator,
+    batch_contact_layer,
+)
+from tightknot.knots.batch_linear import single_blas_thread
+from tightknot.knots.batch_newton import (
+    LinearStats,
+    LockstepStats,
+    RodProblem,
+    continuation_gen,
+    newton_gen,
+    run_lockstep,
+)
+from tightknot.knots.scenes import KnotScene, gauge
 from tightknot.knots.tie import _opts as tie_continuation_options
 from tightknot.knots.tie import knot_type_of
-from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.contact import ContactLayer
 from tightknot.rods.model import Model
-from tightknot.rods.state import State
-from tightknot.solvers.newton import NewtonOptions, newton_solve
-from tightknot.solvers.static import StaticResult, StepRecord, solve_static
+from tightknot.solvers.linear import SparsePattern
+from tightknot.solvers.newton import NewtonOptions
+from tightknot.solvers.static import StaticResult, StepRecord
 from tightknot.solvers.system import RodSystem
 
 #: Gap between the bounding boxes of two copies, in rest diameters: far beyond the
@@ -61,7 +72,33 @@ class BatchModel:
     model: Model
     offsets: np.ndarray
     scenes: list[KnotScene]
-    contact: ContactLayer
+    contact: BatchContactLayer
+
+
+@dataclass
+class RodOutcome:
+    """Outcome of one rod of a batch (as :class:`tightknot.knots.tie.TieResult`).
+
+    Attributes:
+        converged: the rod reached its rest length with its knot type kept.
+        failure: what failed and where ("" when converged).
+        newton_iterations: its Newton iterations, failed attempts included.
+        knot_types: knot type after each converged step.
+        phases: the continuation result of its tightening.
+        linear: its factorizations (banded Cholesky, banded LU where it failed).
+        check_s: wall-clock time of its knot-type checks [s].
+        system: its own one-rod system at the result, with its scene's contact layer, so
+            that it evaluates on its own (state in the scene's frame).
+    """
+
+    converged: bool
+    failure: str
+    newton_iterations: int
+    knot_types: list[str]
+    phases: dict[str, StaticResult]
+    linear: LinearStats
+    check_s: float
+    system: RodSystem
 
 
 @dataclass
@@ -70,23 +107,34 @@ class BatchResult:
 
     Attributes:
         converged: every rod reached its rest length with its knot type kept.
-        failure: what failed and where ("" when converged).
+        failure: the first failed rod and what failed ("" when converged).
         positions: final centerline of each rod in its own scene's frame [m].
-        newton_iterations: Newton iterations of the joint loop (each one covers all rods).
+        newton_iterations: Newton iterations summed over the rods.
+        rounds: rounds of the lockstep (each one evaluation and one step-bound launch set
+            for all rods that had a question).
         wall_time_s: wall-clock time [s].
-        knot_types: knot type of each rod after the last converged step.
-        phases: the continuation result of each phase, by name.
-        system: the joint system (its state is the result, copies offset in space).
+        knot_types: knot type of each rod after its last converged step.
+        rods: each rod's outcome.
+        stats: where the lockstep's time went.
+        evaluator: the batch's evaluator (at the result: every rod's final state).
     """
 
     converged: bool
     failure: str
     positions: list[np.ndarray]
     newton_iterations: int
+    rounds: int
     wall_time_s: float
     knot_types: list[str] = field(default_factory=list)
-    phases: dict[str, StaticResult] = field(default_factory=dict)
-    system: RodSystem | None = None
+    rods: list[RodOutcome] = field(default_factory=list)
+    stats: LockstepStats | None = None
+    evaluator: BatchEvaluator | None = None
+
+
+def _layer_settings(layer: ContactLayer) -> tuple:
+    return (layer.hard_fraction, layer.core_fraction, layer.hard_relative,
+            layer._local_window, layer._gxi.shape[0], float(layer._law.numpy()[10]),
+            float(layer.exclusion[0] / layer.edge_diameter[0]))
 
 
 def build_batch(scenes: list[KnotScene]) -> BatchModel:
@@ -109,9 +157,10 @@ def build_batch(scenes: list[KnotScene]) -> BatchModel:
         if sc.model.twist != twist or sc.model.device != device:
             raise ValueError(f"scenes[{k}] differs from scenes[0] in twist or device: one "
                              "model has one twist setting and one device")
-        if sc.contact.law != law:
-            raise ValueError(f"scenes[{k}] has another contact law than scenes[0]: one "
-                             "contact layer has one law")
+        if sc.contact.law != law or _layer_settings(sc.contact) != _layer_settings(
+                first.contact):
+            raise ValueError(f"scenes[{k}] has another contact law or contact settings than "
+                             "scenes[0]: one contact layer has one law")
     boxes = [(sc.model.vertex_initial_position.min(axis=0),
               sc.model.vertex_initial_position.max(axis=0)) for sc in scenes]
     size = max(float((hi - lo).max()) for lo, hi in boxes)
@@ -127,31 +176,75 @@ def build_batch(scenes: list[KnotScene]) -> BatchModel:
                         info.material, closed=True,
                         edge_rest_lengths=sc.model.edge_rest_length)
     model = builder.finalize(device)
-    return BatchModel(model, offsets, list(scenes), ContactLayer(model, law))
+    return BatchModel(model, offsets, list(scenes), batch_contact_layer(model, first.contact))
 
 
-def batch_gauge(batch: BatchModel, positions: np.ndarray | None = None) -> BoundaryConditions:
-    """The closed-knot gauge of :func:`tightknot.knots.scenes.gauge`, on every rod."""
-    model = batch.model
-    bcs = BoundaryConditions(model, positions)
-    for r, info in enumerate(model.rods):
-        n = info.vertex_count
-        bcs.pin(r, 0).fix_components(r, n // 3, (1, 2)).fix_components(r, 2 * n // 3, (2,))
-        if model.twist:
-            bcs.fix_twist(r, 0)  # the uniform-twist rotation is a zero mode
-    return bcs
 
+def _tie_program(k: int, scene: KnotScene, evaluator: BatchEvaluator, tighten_steps: int,
+                 residual_tol: float, relax_iterations: int):
+    """The closed-knot path of :func:`tightknot.knots.tie.tie` for rod ``k`` (generator)."""
+    types: list[str] = []
+    phases: dict[str, StaticResult] = {}
+    iters = 0
+    check_s = [0.0]
+    model = scene.model
 
-def _knot_types(batch: BatchModel, x: np.ndarray) -> list[str]:
-    return [knot_type_of(sc, x[info.vertex_slice] - batch.offsets[r])
-            for r, (sc, info) in enumerate(zip(batch.scenes, batch.model.rods, strict=True))]
+    def done(ok: bool, msg: str, p: RodProblem) -> RodOutcome:
+        system = p.system
+        system.add_term(scene.contact)
+        return RodOutcome(ok, msg, iters, types, phases, p.stats, check_s[0], system)
 
+    shrink = 1.0 / scene.start_length_ratio
+    system = RodSystem(model, scene.state.copy(), gauge(scene))
+    scene.contact.check_no_intersection(system.state.x)
+    p = RodProblem(k, system, evaluator)
+    p.set_load(0.0)
+    relax = yield from newton_gen(p, system.free_vector(),
+                                  NewtonOptions(residual_tol=residual_tol,
+                                                max_iterations=relax_iterations))
+    iters += relax.iterations
+    if not relax.converged:
+        return done(False, f"relax: Newton {relax.reason} (residual {relax.residual:.3g}) at "
+                    "the start", p)
+    t0 = time.perf_counter()
+    kt = knot_type_of(scene, system.state.x)
+    check_s[0] += time.perf_counter() - t0
+    types.append(kt)
+    if kt != scene.knot_type:
+        return done(False, f"relax: knot type {kt}, expected {scene.knot_type}", p)
+    bcs = gauge(scene, positions=system.state.x)
+    bcs.rest_length_scale((1.0, shrink))
+    system = RodSystem(model, system.state, bcs)
+    scene.contact.check_no_intersection(system.state.x)
+    stats = p.stats
+    p = RodProblem(k, system, evaluator)
+    p.stats = stats
+    p.set_load(0.0)
 
-def _first_wrong(batch: BatchModel, types: list[str]) -> int | None:
-    for r, (sc, kt) in enumerate(zip(batch.scenes, types, strict=True)):
-        if kt != sc.knot_type:
-            return r
-    return None
+    def similar(prob: RodProblem, t0: float, t1: float) -> None:
+        # tie()'s self-similar predictor: the previous equilibrium scaled about the pinned
+        # first vertex (the origin of the scene's frame) keeps every strain.
+        c = (1.0 + (shrink - 1.0) * t1) / (1.0 + (shrink - 1.0) * t0)
+        prob.system.state.x = prob.system.state.x * c
+        prob.set_load(t1)
+
+    def check(sys_: RodSystem, rec: StepRecord) -> str | None:
+        t0 = time.perf_counter()
+        kt = knot_type_of(scene, sys_.state.x)
+        check_s[0] += time.perf_counter() - t0
+        types.append(kt)
+        if kt != scene.knot_type:
+            return (f"topology changed in phase tighten at load t={rec.t:.4g}: knot type "
+                    f"{kt}, expected {scene.knot_type} (the rod passed through itself)")
+        return None
+
+    res = yield from continuation_gen(p, tie_continuation_options(tighten_steps, residual_tol),
+                                      check, similar)
+    phases["tighten"] = res
+    iters += res.newton_iterations
+    if not res.converged:
+        return done(False, f"tighten: {res.failure}", p)
+    return done(True, "", p)
 
 
 def tie_batch(
@@ -160,84 +253,39 @@ def tie_batch(
     residual_tol: float = 1e-6,
     relax_iterations: int = 2000,
 ) -> BatchResult:
-    """Tie closed knots together: relax the start curves, then shrink each rod's rest
-    length from its start length to its L0 by one shared continuation (as
-    :func:`tightknot.knots.tie.tie` does for one knot).
+    """Tie closed knots together, each along its own path as :func:`tightknot.knots.tie.tie`
+    would (relax the start curve, then shrink the rest length from the start length to L0
+    by load continuation), with one evaluation of all rods per round.
 
     Args:
-        scenes: closed knot scenes (same twist setting, device and contact law).
-        tighten_steps: initial number of load steps (adaptive afterwards).
-        residual_tol: Newton tolerance on the scaled residual, over all rods.
-        relax_iterations: Newton budget of the relaxation of the start curves.
+        scenes: closed knot scenes (same twist setting, device and contact settings).
+        tighten_steps: initial number of load steps (adaptive afterwards, per rod).
+        residual_tol: Newton tolerance on each rod's scaled residual.
+        relax_iterations: Newton budget of the relaxation of each start curve.
     """
     if not (math.isfinite(residual_tol) and residual_tol > 0):
         raise ValueError(f"residual_tol must be finite and > 0, got {residual_tol!r}")
     if int(tighten_steps) != tighten_steps or tighten_steps < 1:
         raise ValueError(f"tighten_steps must be a whole number >= 1, got {tighten_steps!r}")
+    if int(relax_iterations) != relax_iterations or relax_iterations < 1:
+        raise ValueError(f"relax_iterations must be a whole number >= 1, got "
+                         f"{relax_iterations!r}")
     start = time.perf_counter()
     batch = build_batch(scenes)
-    model = batch.model
-    rods = model.rods
-    phases: dict[str, StaticResult] = {}
-    iters = 0
-    types: list[str] = []
-
-    def result(ok: bool, msg: str, system: RodSystem) -> BatchResult:
-        x = system.state.x
-        pos = [x[info.vertex_slice] - batch.offsets[r] for r, info in enumerate(rods)]
-        return BatchResult(ok, msg, pos, iters, time.perf_counter() - start, list(types),
-                           phases, system)
-
-    # Relax the start curves (not equilibria), all at once.
-    system = RodSystem(model, State.initial(model), batch_gauge(batch))
-    system.add_term(batch.contact)
-    system.set_load(0.0)
-    relax = newton_solve(system, system.free_vector(),
-                         NewtonOptions(residual_tol=residual_tol, max_iterations=relax_iterations))
-    iters += relax.iterations
-    if not relax.converged:
-        return result(False, f"relax: Newton {relax.reason} (residual {relax.residual:.3g})",
-                      system)
-    types = _knot_types(batch, system.state.x)
-    bad = _first_wrong(batch, types)
-    if bad is not None:
-        return result(False, f"relax: rod {bad} has knot type {types[bad]}, expected "
-                      f"{scenes[bad].knot_type}", system)
-
-    # Shrink every rod's rest length from its start length to its L0 along one path.
-    shrink = np.array([1.0 / sc.start_length_ratio for sc in scenes])
-    bcs = batch_gauge(batch, positions=system.state.x)
-    for r in range(len(rods)):
-        bcs.rest_length_scale((1.0, float(shrink[r])), rod=r)
-    system = RodSystem(model, system.state, bcs)
-    system.add_term(batch.contact)
-    system.set_load(0.0)
-    first = np.array([info.vertex_start for info in rods])
-    vrod = model.vertex_rod
-
-    def similar(sys_: RodSystem, t0: float, t1: float) -> None:
-        # tie()'s self-similar predictor, per rod about its pinned first vertex: the
-        # previous equilibrium scaled by the change of its rest length keeps every strain.
-        c = (1.0 + (shrink - 1.0) * t1) / (1.0 + (shrink - 1.0) * t0)
-        x = sys_.state.x
-        pivot = x[first][vrod]
-        sys_.state.x = pivot + (x - pivot) * c[vrod][:, None]
-        sys_.set_load(t1)
-
-    def check(sys_: RodSystem, rec: StepRecord) -> str | None:
-        nonlocal types
-        types = _knot_types(batch, sys_.state.x)
-        r = _first_wrong(batch, types)
-        if r is not None:
-            return (f"topology changed in phase tighten at load t={rec.t:.4g}: rod {r} has "
-                    f"knot type {types[r]}, expected {scenes[r].knot_type} (the rod passed "
-                    "through itself)")
-        return None
-
-    res = solve_static(system, tie_continuation_options(tighten_steps, residual_tol),
-                       callback=check, predictor=similar)
-    phases["tighten"] = res
-    iters += res.newton_iterations
-    if not res.converged:
-        return result(False, f"tighten: {res.failure}", system)
-    return result(True, "", system)
+    patterns = [SparsePattern(sc.model, ~gauge(sc).fixed_mask()) for sc in scenes]
+    evaluator = BatchEvaluator(batch.model, batch.contact, batch.offsets,
+                               [sc.model for sc in scenes], patterns)
+    programs = [_tie_program(k, sc, evaluator, int(tighten_steps), residual_tol,
+                             int(relax_iterations)) for k, sc in enumerate(scenes)]
+    stats = LockstepStats()
+    with single_blas_thread():
+        outcomes: list[RodOutcome] = run_lockstep(programs, evaluator, stats)  # type: ignore
+    failed = [k for k, o in enumerate(outcomes) if not o.converged]
+    failure = (f"rod {failed[0]} ({scenes[failed[0]].name}, L0/D0 "
+               f"{scenes[failed[0]].rest_length / scenes[failed[0]].diameter:.4g}): "
+               f"{outcomes[failed[0]].failure}" if failed else "")
+    return BatchResult(
+        not failed, failure, [o.system.state.x.copy() for o in outcomes],
+        sum(o.newton_iterations for o in outcomes), stats.rounds,
+        time.perf_counter() - start, [o.knot_types[-1] if o.knot_types else "" for o in
+                                      outcomes], outcomes, stats, evaluator)

@@ -1,0 +1,449 @@
+"""Each rod of a batch runs tie()'s own solver; all rods advance together.
+
+:func:`tightknot.knots.tie.tie` ties a closed knot by a Newton relaxation, then a load
+continuation (:func:`tightknot.solvers.static.solve_static`) whose failed steps are
+retried by proximal steps (:func:`tightknot.solvers.dynamic.proximal_relax`), each step a
+damped Newton solve (:func:`tightknot.solvers.newton.newton_solve`). Here the same logic
+runs for every rod, with the rod's own load parameter, step length, shift, line search and
+convergence test, written as a generator that yields each question it has about its
+potential (an energy, gradient and Hessian, or a collision-free step bound) instead of
+evaluating it. :func:`run_lockstep` collects the pending questions of all rods and answers
+them together (:class:`tightknot.knots.batch_eval.BatchEvaluator`: one set of launches),
+so a rod that is done costs nothing and no rod waits for another's load step. A rod
+therefore follows its own tie's path, up to the round-off of the joint evaluation (sums in
+another order) and of the linear solve (banded Cholesky where the matrix is positive
+definite, banded LU otherwise, :mod:`tightknot.knots.batch_linear`, where the one-rod
+solver uses SuperLU).
+
+The generators mirror the owner's solvers line by line (same options, same tests, same
+messages); a change there must be made here too (``tests/knots/test_batch.py`` compares
+each rod with its own tie).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Generator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tightknot.knots.batch_eval import (
+    BatchEvaluator,
+    EvalRequest,
+    HessianData,
+    StepRequest,
+)
+from tightknot.knots.batch_linear import BandedCholesky, BandPlan, banded_lu_solve
+from tightknot.solvers.dynamic import ProximalResult
+from tightknot.solvers.linear import factorize
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, _acceptable, _stalled
+from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord
+from tightknot.solvers.system import EnergySplit, Inertia, RodSystem
+
+#: What a rod's generator yields (a question) and is sent back (the answer).
+Request = EvalRequest | StepRequest
+RodGen = Generator[Request, object, object]
+
+
+@dataclass
+class LinearStats:
+    """Factorizations of one rod: banded Cholesky, banded LU where it failed, SuperLU where
+    the band was too wide, and their wall-clock time [s]."""
+
+    cholesky: int = 0
+    lu: int = 0
+    superlu: int = 0
+    seconds: float = 0.0
+
+
+class RodProblem:
+    """One rod's potential as the Newton loop sees it (the NewtonProblem of one-rod
+    solves), answered by the batch evaluator.
+
+    Args:
+        k: rod index in the batch.
+        system: the rod's own system (its model, boundary conditions, load and state).
+        evaluator: the batch's evaluator.
+    """
+
+    #: Largest n bw^2 (dofs times half-bandwidth squared) solved in band storage: banded
+    #: LU costs about 4 n bw^2 flops; at 393 dofs a band of 81 took 0.5 ms (SuperLU 1.5),
+    #: one of 230 (a few distant contacts of a loose knot) far longer than SuperLU.
+    BAND_WORK_LIMIT = 5e6
+
+    def __init__(self, k: int, system: RodSystem, evaluator: BatchEvaluator) -> None:
+        self.k = k
+        self.system = system
+        self.evaluator = evaluator
+        if np.any(system.f_ext != 0.0) or system.gravity is not None:
+            raise ValueError("batched rods carry no dead load (closed knots)")
+        own = evaluator.rods[k].pattern
+        if not np.array_equal(own.free_dofs, system.pattern.free_dofs):
+            raise ValueError(f"rod {k}'s boundary conditions changed its free dofs")
+        self.inertia: Inertia | None = None
+        self.last_split = EnergySplit()
+        self.trial: tuple[np.ndarray, ...] | None = None
+        self.stats = LinearStats()
+        self._plan: tuple[np.ndarray, BandPlan] | None = None
+        self._cache: tuple | None = None
+
+    # -- load path ---------------------------------------------------------------------
+    def set_load(self, t: float) -> None:
+        """As RodSystem.set_load, and tell the evaluator the rod's new rest lengths."""
+        self.system.set_load(t)
+        self.evaluator.set_rest(self.k, self.system.rest)
+        self.evaluator.compact(self.k)
+
+    # -- evaluation (yields the question) ------------------------------------------------
+    def evaluate(self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True):
+        """Total potential [J], free-dof gradient and Hessian at ``u`` (as RodSystem).
+
+        Every question asks for all three (:class:`EvalRequest`); the last answer is kept,
+        so that the full evaluation at an accepted trial point costs no second round. It
+        is reused only at the same ``u``, the same rest lengths and base frames that are
+        either those it was carried from or its own (after the trial was accepted: the
+        one-rod solver carries the frames once more, onto the same tangents, which changes
+        them by round-off only)."""
+        s = self.system
+        st = s.state
+        q = s.full_dofs()
+        q[s.pattern.free_dofs] = u
+        x = q[s.model.position_dofs]
+        theta = q[s.model.edge_dof] if s.model.twist else st.theta
+        c = self._cache
+        if (c is not None and c[1] is s.rest and (c[2] is st.d1_ref or c[3].d1 is st.d1_ref)
+                and np.array_equal(c[0], u)):
+            ans = c[3]
+        else:
+            ans = yield EvalRequest(self.k, x, theta, st.d1_ref, st.t_ref, st.m_ref)
+            self._cache = (u.copy(), s.rest, st.d1_ref, ans)
+        self.trial = (u.copy(), x, theta, ans.d1, ans.t, ans.m_ref)
+        split = EnergySplit(stretch=ans.stretch, bend=ans.bend, twist=ans.twist)
+        split.extra["contact"] = ans.contact
+        grad = ans.grad
+        if self.inertia is not None:
+            dq = q - self.inertia.q_hat
+            w = self.inertia.mass / self.inertia.dt**2
+            split.inertia = 0.5 * float(np.sum(w * dq * dq))
+            grad = grad + w * dq
+        self.last_split = split
+        free = s.pattern.free_dofs
+        g_free = grad[free] if (want_grad or want_hess) else None
+        h = None
+        if want_hess:
+            h = ans.hess
+            if self.inertia is not None:
+                w = self.inertia.mass / self.inertia.dt**2
+                data = h.data.copy()
+                data[h.diag_slot] += w[free]
+                h = HessianData(h.indptr, h.indices, h.diag_slot, data)
+        return split.total, g_free, h
+
+    def max_step(self, u: np.ndarray, du: np.ndarray):
+        """Largest step fraction the contact layer allows (yields the question)."""
+        x0 = self.system.positions(u)
+        dx = self.system.positions(u + du) - x0
+        alpha = yield StepRequest(self.k, x0, dx)
+        return alpha
+
+    def accept(self, u: np.ndarray):
+        """Make ``u`` the state (re-evaluated first if it was not the last trial)."""
+        if self.trial is None or not np.array_equal(self.trial[0], u):
+            yield from self.evaluate(u, want_grad=False, want_hess=False)
+        _, x, theta, d1, tt, mref = self.trial
+        st = self.system.state
+        st.x, st.d1_ref, st.t_ref, st.m_ref = x.copy(), d1, tt, mref
+        if self.system.model.twist:
+            st.theta = theta.copy()
+
+    def energy_roundoff(self) -> float:
+        """As RodSystem.energy_roundoff [J]."""
+        return 1e-13 * self.last_split.magnitude
+
+    # -- linear algebra ----------------------------------------------------------------------
+    def shifted_direction(self, h: HessianData, g: np.ndarray, mu: float,
+                          diag: np.ndarray) -> np.ndarray | None:
+        """Solve (H + mu D) d = -g (as the Newton loop's ``_shifted_direction``)."""
+        t0 = time.perf_counter()
+        try:
+            return self._solve(h, g, mu, diag)
+        finally:
+            self.stats.seconds += time.perf_counter() - t0
+
+    def _solve(self, h: HessianData, g: np.ndarray, mu: float,
+               diag: np.ndarray) -> np.ndarray | None:
+        a = h.data.copy()
+        if mu != 0.0:
+            a[h.diag_slot] += mu * diag
+        if self._plan is None or self._plan[0] is not h.indptr:
+            # The ordering depends only on the pattern, which changes with the contact set.
+            self._plan = (h.indptr, BandPlan(h.indptr, h.indices))
+        plan = self._plan[1]
+        if plan.n * plan.bandwidth**2 > self.BAND_WORK_LIMIT:
+            # A band of most of the matrix (a few contacts far apart along the rod while
+            # the knot is loose): band storage would be dense work; SuperLU as one rod.
+            self.stats.superlu += 1
+            try:
+                d = factorize(h.matrix(a)).solve(-g)
+            except RuntimeError:  # exactly singular
+                return None
+            return d if np.isfinite(d).all() else None
+        chol = BandedCholesky.try_factor(plan, a)
+        if chol is not None:
+            self.stats.cholesky += 1
+            d = chol.solve(-g)
+        else:
+            self.stats.lu += 1
+            d = banded_lu_solve(self._plan[1], a, -g)
+            if d is None:  # exactly singular
+                return None
+        return d if np.isfinite(d).all() else None
+
+
+def newton_gen(p: RodProblem, u0: np.ndarray, options: NewtonOptions | None = None):
+    """:func:`tightknot.solvers.newton.newton_solve` for one rod of the batch."""
+    opt = options or NewtonOptions()
+    u = np.array(u0, dtype=np.float64)
+    energy, g, hp = yield from p.evaluate(u, True, True)
+    if not (math.isfinite(energy) and np.isfinite(g).all()):
+        return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
+    res = p.system.residual_norm(g)
+    if not math.isfinite(res):
+        return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
+    history = [res]
+    mu = 0.0
+    step = math.inf
+    if res <= opt.residual_tol:
+        yield from p.accept(u)
+        return NewtonResult(True, 0, res, 0.0, energy, "converged", history)
+    best = [res]
+    energies = [energy]
+    for it in range(1, opt.max_iterations + 1):
+        accepted = False
+        h = hp.matrix()
+        diag = np.abs(h.diagonal())
+        diag = np.maximum(diag, 1e-12 * (diag.max() if diag.size else 1.0))
+        while not accepted:
+            d = p.shifted_direction(hp, g, mu, diag)
+            if d is None or not _acceptable(d, g, h, mu, diag):
+                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
+                if mu > opt.shift_max:
+                    yield from p.accept(u)
+                    return NewtonResult(False, it, res, step, energy, "line_search_failed",
+                                        history)
+                continue
+            alpha = min(1.0, (yield from p.max_step(u, d)))
+            slope = float(g @ d)
+            roundoff = p.energy_roundoff()
+            for _ in range(opt.max_backtracks):
+                trial = u + alpha * d
+                e_trial, _, _ = yield from p.evaluate(trial, False, False)
+                if not math.isfinite(e_trial):
+                    alpha *= 0.5
+                    continue
+                if e_trial <= energy + opt.armijo * alpha * slope:
+                    accepted = True
+                    break
+                if -alpha * slope <= roundoff and e_trial <= energy + roundoff:
+                    accepted = True
+                    break
+                alpha *= 0.5
+            if not accepted:
+                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
+                if mu > opt.shift_max:
+                    yield from p.accept(u)
+                    return NewtonResult(False, it, res, step, energy, "line_search_failed",
+                                        history)
+        du = alpha * d
+        predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ (h @ d)))
+        u = u + du
+        step = p.system.step_norm(du)
+        yield from p.accept(u)
+        e_old = energy
+        energy, g, hp = yield from p.evaluate(u, True, True)
+        if not (math.isfinite(energy) and np.isfinite(g).all()):
+            return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
+        res = p.system.residual_norm(g)
+        if not math.isfinite(res):
+            return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
+        history.append(res)
+        ratio = (e_old - energy) / predicted if predicted > 0 else 1.0
+        if alpha < 0.5 or ratio < 0.25:
+            mu = max(4.0 * mu, opt.shift_trust)
+        elif alpha == 1.0 and ratio > 0.75:
+            mu = 0.0 if mu <= opt.shift_trust else mu / 4.0
+        if res <= opt.residual_tol:
+            return NewtonResult(True, it, res, step, energy, "converged", history)
+        if step <= opt.step_tol and res > opt.stall_factor * history[-2]:
+            return NewtonResult(False, it, res, step, energy, "stagnated", history)
+        best.append(min(best[-1], res))
+        energies.append(energy)
+        if _stalled(best, energies, opt, p.energy_roundoff()):
+            return NewtonResult(False, it, res, step, energy, "stalled", history)
+    return NewtonResult(False, opt.max_iterations, res, step, energy, "max_iterations", history)
+
+
+def proximal_gen(p: RodProblem, dt: float = 1e-3, max_steps: int = 200,
+                 options: NewtonOptions | None = None, grow_below: int = 8):
+    """:func:`tightknot.solvers.dynamic.proximal_relax` for one rod of the batch."""
+    s = p.system
+    if not (s.model.vertex_mass > 0).all():
+        raise ValueError("proximal relaxation needs density > 0 for every rod")
+    opts = options or NewtonOptions()
+    iters = 0
+    for k in range(1, max_steps + 1):
+        saved = s.state.copy()
+        p.inertia = Inertia(dt=dt, q_hat=s.full_dofs(), mass=s.dof_mass)
+        try:
+            res = yield from newton_gen(p, s.free_vector(), opts)
+        finally:
+            p.inertia = None
+        iters += res.iterations
+        if not res.converged:
+            s.state = saved
+            dt *= 0.25
+            continue
+        if res.iterations < grow_below:
+            dt *= 2.0
+        static = yield from newton_gen(
+            p, s.free_vector(), NewtonOptions(residual_tol=opts.residual_tol, max_iterations=15))
+        iters += static.iterations
+        if static.converged:
+            return ProximalResult(True, k, iters, "converged")
+    return ProximalResult(False, max_steps, iters, "max_steps")
+
+
+StepCheck = Callable[[RodSystem, StepRecord], str | None]
+Predictor = Callable[[RodProblem, float, float], None]
+
+
+def continuation_gen(p: RodProblem, opt: ContinuationOptions, callback: StepCheck | None,
+                     predictor: Predictor | None):
+    """:func:`tightknot.solvers.static.solve_static` (from t = 0) for one rod."""
+    s = p.system
+    start = time.perf_counter()
+    t = 0.0
+    dt = min(opt.max_step, 1.0 / opt.steps)
+    records: list[StepRecord] = []
+    total_iters = 0
+    while t < 1.0 - 1e-14:
+        t_next = min(1.0, t + dt)
+        saved = s.state.copy()
+        p.set_load(t_next)
+        if predictor is not None:
+            predictor(p, t, t_next)
+        res = yield from newton_gen(p, s.free_vector(), opt.newton)
+        total_iters += res.iterations
+        if not res.converged and opt.proximal_dt is not None:
+            prox = yield from proximal_gen(p, opt.proximal_dt, opt.proximal_steps, opt.newton)
+            total_iters += prox.newton_iterations
+            if prox.converged:
+                _, g, _ = yield from p.evaluate(s.free_vector(), True, False)
+                res = NewtonResult(True, res.iterations + prox.newton_iterations,
+                                   s.residual_norm(g), 0.0, p.last_split.total,
+                                   "converged_by_proximal_steps", res.history)
+        where = f"load step {len(records) + 1} (from t={t:.6g} to t={t_next:.6g})"
+        if not res.converged:
+            failed = s.state.copy()
+            s.state = saved
+            p.set_load(t)
+            dt *= 0.5
+            why = None
+            if dt < opt.min_step:
+                why = f"step halved below min_step={opt.min_step:g}"
+            elif opt.max_newton_iterations is not None and \
+                    total_iters >= opt.max_newton_iterations:
+                why = f"Newton budget of {opt.max_newton_iterations} iterations spent"
+            if why is not None:
+                return StaticResult(
+                    False, t, records, total_iters,
+                    f"Newton {res.reason} (residual {res.residual:.3g}) at {where}; {why}",
+                    time.perf_counter() - start, failed)
+            continue
+        rec = StepRecord(t_next, res)
+        records.append(rec)
+        t = t_next
+        if callback is not None:
+            reason = callback(s, rec)
+            if reason:
+                return StaticResult(False, t, records, total_iters, f"{reason} [{where}]",
+                                    time.perf_counter() - start, s.state.copy())
+        if (opt.max_newton_iterations is not None and total_iters >= opt.max_newton_iterations
+                and t < 1.0 - 1e-14):
+            return StaticResult(
+                False, t, records, total_iters,
+                f"Newton budget of {opt.max_newton_iterations} iterations spent after {where}",
+                time.perf_counter() - start, s.state.copy())
+        if res.iterations < opt.grow_below:
+            dt = min(opt.max_step, dt * 2.0)
+    return StaticResult(True, 1.0, records, total_iters, "", time.perf_counter() - start)
+
+
+@dataclass
+class LockstepStats:
+    """Work of a lockstep run.
+
+    Attributes:
+        rounds: rounds of questions (each answered by at most one evaluation and one
+            step-bound launch set).
+        evaluations: evaluation launch sets (over all rods).
+        step_bounds: step-bound launch sets.
+        answered: questions answered (over all rods).
+        evaluate_s, step_bound_s: wall-clock time in the evaluator [s].
+        rod_s: wall-clock time in the rods' own work (linear solves, checks) [s].
+    """
+
+    rounds: int = 0
+    evaluations: int = 0
+    step_bounds: int = 0
+    answered: int = 0
+    evaluate_s: float = 0.0
+    step_bound_s: float = 0.0
+    rod_s: float = 0.0
+    active: list[int] = field(default_factory=list)
+
+
+def run_lockstep(programs: list[RodGen], evaluator: BatchEvaluator,
+                 stats: LockstepStats | None = None) -> list[object]:
+    """Run the rods' generators together until each returns; their return values."""
+    stats = stats if stats is not None else LockstepStats()
+    results: list[object] = [None] * len(programs)
+    pending: dict[int, Request] = {}
+
+    def advance(k: int, answer: object) -> None:
+        t0 = time.perf_counter()
+        try:
+            pending[k] = programs[k].send(answer)
+        except StopIteration as stop:
+            results[k] = stop.value
+            pending.pop(k, None)
+        stats.rod_s += time.perf_counter() - t0
+
+    for k in range(len(programs)):
+        advance(k, None)
+    while pending:
+        stats.rounds += 1
+        stats.active.append(len(pending))
+        # Step bounds first: the rods that get one ask for their trial point's energy
+        # next, which the evaluation of this same round then answers.
+        steps = [q for q in pending.values() if isinstance(q, StepRequest)]
+        if steps:
+            t0 = time.perf_counter()
+            bounds = evaluator.max_step(steps)
+            stats.step_bound_s += time.perf_counter() - t0
+            stats.step_bounds += 1
+            stats.answered += len(bounds)
+            for k, alpha in bounds.items():
+                advance(k, alpha)
+        evals = [q for q in pending.values() if isinstance(q, EvalRequest)]
+        if evals:
+            t0 = time.perf_counter()
+            answers = evaluator.evaluate(evals)
+            stats.evaluate_s += time.perf_counter() - t0
+            stats.evaluations += 1
+            stats.answered += len(answers)
+            for k, ans in answers.items():
+                advance(k, ans)
+    return results
