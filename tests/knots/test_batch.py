@@ -142,8 +142,11 @@ def test_banded_solves_equal_superlu(shift: float, definite: bool):
     plan = BandPlan(a.indptr, a.indices)
     b = np.random.default_rng(4).normal(size=120)
     want = factorize(a).solve(b)
-    chol = BandedCholesky.try_factor(plan, a.data)
+    chol, z = BandedCholesky.factor_or_certificate(plan, a.data)
     assert (chol is not None) == definite
+    if not definite:
+        # The certificate of indefiniteness: a direction of negative curvature.
+        assert z @ (a @ z) < 0.0
     for got in ([chol.solve(b)] if chol else []) + [banded_lu_solve(plan, a.data, b)]:
         # Both direct solves of a well-conditioned system: agreement to ~1e-12 relative.
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-10 * np.abs(want).max())

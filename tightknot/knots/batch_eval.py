@@ -48,31 +48,43 @@ class BatchContactLayer(ContactLayer):
 
     #: Rods whose candidate pairs are kept (None: all).
     rod_mask: np.ndarray | None = None
+    #: Candidate pairs of the last detection (host), reused by :meth:`pair_terms` when
+    #: asked to (the same positions evaluated again for some rods).
+    _last_candidates: np.ndarray | None = None
+    _reuse: bool = False
+    _store: bool = False
 
     def _candidates(self, wx: wp.array, wdx: wp.array, margin: wp.array, arcs: wp.array,
                     rod_len: wp.array) -> wp.array:
-        pairs = super()._candidates(wx, wdx, margin, arcs, rod_len)
-        if self.rod_mask is None or pairs.shape[0] == 0:
-            return pairs
-        pn = pairs.numpy()
+        if self._reuse:
+            pn = self._last_candidates
+        else:
+            pairs = super()._candidates(wx, wdx, margin, arcs, rod_len)
+            if self.rod_mask is None:
+                return pairs
+            pn = pairs.numpy()
+            if self._store:
+                self._last_candidates = pn.copy()
         keep = self.rod_mask[self.model.edge_rod[pn[:, 0]]]
-        if keep.all():
-            return pairs
-        return wp.array(np.ascontiguousarray(pn[keep]), dtype=wp.vec2i, device=self.device)
+        return wp.array(np.ascontiguousarray(pn[keep]).reshape(-1, 2), dtype=wp.vec2i,
+                        device=self.device)
 
     def pair_terms(self, x: np.ndarray, rest: np.ndarray, rods: np.ndarray,
-                   tables: tuple[wp.array, ...], csc: wp.array
+                   tables: tuple[wp.array, ...], csc: wp.array, again: bool = False
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, wp.array, int]:
         """Candidate pairs (P, 2) of the rods in mask ``rods``, their energies [J] and
         overlaps [m] (P,), the gradient over vertex positions (Warp, (V, 3)) [N] and the
         count of Hessian blocks missing from ``tables`` (the Hessian is added into
-        ``csc``)."""
+        ``csc``). ``again``: the same positions as the last call, whose candidate pairs
+        are reused (no new detection)."""
         self.rod_mask = rods
+        self._reuse, self._store = again, not again
         try:
             pairs, e_pair, grad, _, overlap, missing = self._launch(x, rest, True, 2, tables,
                                                                     csc)
         finally:
             self.rod_mask = None
+            self._reuse = self._store = False
         self._remember(pairs, overlap)
         return self.last_pairs, e_pair, overlap, grad, int(missing.numpy()[0])
 
@@ -228,6 +240,8 @@ class BatchEvaluator:
     #: Spare room of a rod's contact region, over its entries, so that new contacts
     #: rarely move the other rods' regions.
     HEADROOM = 1.5
+    #: Gap [D0] below which a pair's blocks join a growing pattern (see _grow).
+    GROW_GAP = 0.05
 
     def __init__(self, model: Model, layer: BatchContactLayer, offsets: np.ndarray,
                  rod_models: list[Model], patterns: list[SparsePattern]) -> None:
@@ -332,6 +346,7 @@ class BatchEvaluator:
             cols.append(np.where(cp.block_cols >= 0, cp.block_cols + r.offset, -1))
         k_all = np.concatenate(keys)
         c_all = np.concatenate(cols).astype(np.int32)
+        self._keys = k_all if k_all.size else np.full(1, -1, np.int64)
         # Row ranges of the table (as ContactPattern.warp_tables): row vr's keys are
         # keys[rows[vr]:rows[vr + 1]].
         rows = np.searchsorted(k_all, np.arange(nv + 1, dtype=np.int64) * nv)
@@ -344,19 +359,34 @@ class BatchEvaluator:
                         self._wrank)
         return full
 
-    def _grow(self, pairs: np.ndarray, e_pair: np.ndarray) -> np.ndarray:
-        """Grow the patterns of the rods whose interacting pairs lack blocks; their mask."""
+    def _grow(self, pairs: np.ndarray, e_pair: np.ndarray, overlap: np.ndarray) -> np.ndarray:
+        """Grow the patterns of the rods whose interacting pairs lack blocks; their mask.
+
+        Such a rod also takes the blocks of its pairs less than ``GROW_GAP`` D0 from
+        touching: a tightening knot's contacts spread to neighbouring pairs one
+        evaluation after another, and each growth costs a pattern rebuild and a second
+        contact launch. (The blocks of all candidate pairs instead widened the band so
+        much that most solves fell back on SuperLU: 44 s of linear algebra instead of
+        26 s for 32 rods.)"""
         m = self.model
         grown = np.zeros(len(self.rods), dtype=bool)
-        active = pairs[e_pair != 0.0]
-        prod = m.edge_rod[active[:, 0]]
-        for k in np.unique(prod):
-            need = self._local_blocks(int(k), active[prod == k])
+        act = e_pair != 0.0
+        active = pairs[act]
+        if not len(active):
+            return grown
+        # Which rods miss blocks: all needed keys at once against the joint table.
+        keys = pair_blocks(m.edge_vertex, active, m.vertex_count)
+        table = self._keys
+        pos = np.minimum(np.searchsorted(table, keys), len(table) - 1)
+        lacking = table[pos] != keys
+        rods = np.unique(m.edge_rod[active[np.flatnonzero(lacking) // 16, 0]])
+        near = act | (overlap > -self.GROW_GAP * self.layer.edge_diameter[pairs[:, 0]])
+        prod = m.edge_rod[pairs[:, 0]]
+        for k in rods:
             cp = self.rods[k].cpattern
-            if not np.isin(need, cp.block_keys).all():
-                cp.grow(need)
-                self.rods[k].dirty = True
-                grown[k] = True
+            cp.grow(self._local_blocks(int(k), pairs[near & (prod == k)]))
+            self.rods[k].dirty = True
+            grown[k] = True
         return grown
 
     # -- evaluation ------------------------------------------------------------------------
@@ -397,11 +427,12 @@ class BatchEvaluator:
         pairs, e_pair, overlap, cgrad, missing = self.layer.pair_terms(
             self.x, self.rest, asking, self._tables, self._cdata)
         redo = asking
+        gp, ge, go = pairs, e_pair, overlap  # what the growth looks at
         while missing:
             # New contact blocks: grow the patterns of the rods that lack them and run the
             # contact kernel again on those rods' pairs (all asking rods' if the regions
             # moved); the energies and gradients of the first run stand.
-            grown = self._grow(pairs, e_pair)
+            grown = self._grow(gp, ge, go)
             if self._layout():
                 redo = asking
                 self._cdata.zero_()
@@ -412,10 +443,9 @@ class BatchEvaluator:
                     r = self.rods[k]
                     cd[r.offset : r.offset + r.capacity] = 0.0
             self.contact_reruns += 1
-            rp, re_, _, _, missing = self.layer.pair_terms(self.x, self.rest, redo,
-                                                            self._tables, self._cdata)
-            if missing:
-                pairs, e_pair = rp, re_
+            gp, ge, go, _, missing = self.layer.pair_terms(self.x, self.rest, redo,
+                                                            self._tables, self._cdata,
+                                                            again=True)
         n_rods = len(self.rods)
         rods_e = m.edge_rod[pairs[:, 0]] if len(pairs) else np.zeros(0, dtype=np.int64)
         e_contact = np.bincount(rods_e, weights=e_pair, minlength=n_rods)

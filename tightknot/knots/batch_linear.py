@@ -93,16 +93,41 @@ class BandedCholesky:
     @classmethod
     def try_factor(cls, plan: BandPlan, data: np.ndarray) -> BandedCholesky | None:
         """Factor the matrix with entries ``data`` (the plan's CSC order), or None."""
+        return cls.factor_or_certificate(plan, data)[0]
+
+    @classmethod
+    def factor_or_certificate(cls, plan: BandPlan, data: np.ndarray
+                              ) -> tuple[BandedCholesky | None, np.ndarray | None]:
+        """The factorization, or None and a vector z with z.A z <= 0 (up to round-off),
+        which proves A is not positive definite: where the factorization stops at column
+        k, the leading block [[A11, a], [a^T, alpha]] has a non-positive Schur complement
+        alpha - a^T A11^-1 a, attained by z = [-A11^-1 a, 1] (Golub & Van Loan 2013,
+        sec. 4.2.8); A11^-1 a costs two band triangular solves with the factor of A11."""
         d = np.abs(data[plan.diag])
         s = 1.0 / np.sqrt(np.where(d > 0.0, d, 1.0))
         n, bw = plan.n, plan.bandwidth
         ab = np.zeros((bw + 1) * n)
         ab[plan.flat] = data[plan.upper] * s[plan.rows_upper] * s[plan.cols_upper]
-        try:
-            c = sla.cholesky_banded(ab.reshape(bw + 1, n), lower=False, check_finite=False)
-        except np.linalg.LinAlgError:  # not positive definite
-            return None
-        return cls(plan, s, c)
+        ab = ab.reshape(bw + 1, n)
+        c, info = lapack.dpbtrf(ab, lower=0)
+        if info == 0:
+            return cls(plan, s, c), None
+        if info < 0:
+            raise RuntimeError(f"dpbtrf: argument {-info} is invalid")
+        k = info - 1  # the failing column (0-based); columns < k hold the factor of A11
+        lo = max(0, k - bw)
+        z = np.zeros(n)
+        z[k] = 1.0
+        if k > 0:
+            a = np.zeros(k)
+            a[lo:] = ab[bw - (k - lo) : bw, k]  # A[lo:k, k] in band storage
+            u = np.ascontiguousarray(c[:, :k])
+            y, _ = lapack.dtbtrs(u, a[:, None], uplo="U", trans="T")
+            w, _ = lapack.dtbtrs(u, y, uplo="U", trans="N")
+            z[:k] = -w[:, 0]
+        x = np.empty(n)
+        x[plan.perm] = z
+        return None, s * x
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solve A x = b."""

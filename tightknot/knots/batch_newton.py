@@ -50,11 +50,13 @@ RodGen = Generator[Request, object, object]
 @dataclass
 class LinearStats:
     """Factorizations of one rod: banded Cholesky, banded LU where it failed, SuperLU where
-    the band was too wide, and their wall-clock time [s]."""
+    the band was too wide, Cholesky attempts skipped (proven indefinite), and their
+    wall-clock time [s]."""
 
     cholesky: int = 0
     lu: int = 0
     superlu: int = 0
+    skipped: int = 0
     seconds: float = 0.0
 
 
@@ -88,6 +90,7 @@ class RodProblem:
         self.stats = LinearStats()
         self._plan: tuple[np.ndarray, BandPlan] | None = None
         self._cache: tuple | None = None
+        self._certificate: tuple[HessianData, float, float] | None = None
 
     # -- load path ---------------------------------------------------------------------
     def set_load(self, t: float) -> None:
@@ -190,7 +193,18 @@ class RodProblem:
             except RuntimeError:  # exactly singular
                 return None
             return d if np.isfinite(d).all() else None
-        chol = BandedCholesky.try_factor(plan, a)
+        # A vector proving H + mu D indefinite at a smaller shift of this Newton iteration
+        # proves it at this shift too while z.(H + mu D)z stays <= 0: skip the Cholesky
+        # attempt (it would fail) and go to LU directly.
+        cert = self._certificate
+        if cert is not None and cert[0] is h and cert[1] + mu * cert[2] <= 0.0:
+            chol = None
+            self.stats.skipped += 1
+        else:
+            chol, z = BandedCholesky.factor_or_certificate(plan, a)
+            if z is not None:
+                hz = h.matrix() @ z
+                self._certificate = (h, float(z @ hz), float(np.sum(diag * z * z)))
         if chol is not None:
             self.stats.cholesky += 1
             d = chol.solve(-g)
