@@ -1,10 +1,12 @@
 """Cross-check FEM versus rod model on the coarse meshes: it runs, the report is complete
 and honest, and the targets that the rod model meets stay met.
 
-Measured on the coarse meshes (see the report of issue 4): indent force -0.3 % to -29 %
-(met up to an approach of 0.048 D0 only), indent area within 1.1 points (met); wrap line
-load -17 % to +435 %, curvature -19 % to +70 %, area within 5 points up to an approach of
-0.12 D0. The misses are recorded, not asserted away.
+The comparison itself runs on the medium mesh (``DEFAULT_MESH``, the calibration's); these
+tests use the coarse one to stay fast. Measured on the coarse meshes (docs/fem_crosscheck.md):
+indent force +0.1 % to -13.5 % (missed from an approach of 0.027 D0 on: the rod model's
+contact layer stretches the rod at the crossing, see ``diagnostics``), indent area within
+1.5 points; wrap curvature of the nominal axis +2 % to +8 % (met), area within 3.3 points
+(met), mid line load -16 % to -24 % (missed). The misses are recorded, not asserted away.
 """
 
 import json
@@ -14,12 +16,23 @@ import pytest
 
 pytest.importorskip("felupe")
 
-from tightknot.fem.crosscheck import APPROACH_LIMIT, TARGETS, crosscheck  # noqa: E402
+from tightknot.fem.crosscheck import (  # noqa: E402
+    APPROACH_LIMIT,
+    DEFAULT_MESH,
+    TARGETS,
+    crosscheck,
+)
 
 
 @pytest.fixture(scope="module")
 def report(indent_coarse, wrap_coarse):
     return crosscheck("coarse", fem_results={"indent": indent_coarse, "wrap": wrap_coarse})
+
+
+def test_default_mesh_is_the_calibration_mesh():
+    from tightknot.fem.calibration import LAW_PATH
+
+    assert DEFAULT_MESH == json.loads(LAW_PATH.read_text())["provenance"]["meshes"]["level"]
 
 
 def test_report_keys_and_json(report):
@@ -58,23 +71,57 @@ def test_indent_targets_that_are_met(report):
     levels = report["scenes"]["indent"]["comparison"]["levels"]
     assert len(levels) == 9  # w = 0.15 (k/10)^2 D0 with 2 w <= 0.25 D0: k = 1..9
     for lv in levels:
-        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 0.011
+        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 0.015
         assert lv["rod_converged"]
     # small loads: the calibrated point law and its kernel agree with the FEM
     for lv in levels[:2]:
-        assert abs(lv["force_rel"]) <= TARGETS["force_rel"]  # measured -0.3 %, +4.4 %
+        assert abs(lv["force_rel"]) <= TARGETS["force_rel"]  # measured +0.1 %, +5.3 %
 
 
 def test_wrap_statics_and_met_targets(report):
     wrap = report["scenes"]["wrap"]
     for row in wrap["total_force_statics"]:
         assert row["fem_over_2T_sin_theta"] == pytest.approx(1.0, rel=1e-6)
-    levels = wrap["comparison"]["levels"]
-    for lv in levels:
+    for lv in wrap["comparison"]["levels"]:
         for key in ("force_rel", "area_points", "curvature_rel"):
             assert math.isfinite(lv[key])
-        if lv["approach_over_d0"] <= 0.12:
-            assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 3.6 pts
+
+
+def test_indent_diagnostics_locate_the_force_deficit(report):
+    rows = report["diagnostics"]["indent_axial"]["levels"]
+    assert len(rows) == 9
+    for row in rows:
+        assert row["rod_nu0_converged"]
+        if row["approach_over_d0"] < 0.025:
+            continue  # patch radius below two elements of the coarse mesh
+        # the rod model's contact layer puts an axial tension into the rod at the crossing
+        # (measured 3.4x to 29x the FEM's): it thins the contact radius, the overlap is
+        # 0.87 to 0.91 of w. A sign error or a lost factor 2 in either would fail these.
+        assert row["rod_axial_force_mid_over_e_d0sq"] > 2.0 * row[
+            "fem_axial_force_mid_over_e_d0sq"]
+        assert row["rod_overlap_over_w"] < 0.95
+        # all of it comes from the radius's thinning with stretch: with nu = 0 the axial
+        # force vanishes (measured |N| < 4e-5 E D0^2 against 0.004 to 0.05 with nu = 1/2)
+        assert abs(row["rod_nu0_axial_force_mid_over_e_d0sq"]) < 0.05 * row[
+            "rod_axial_force_mid_over_e_d0sq"]
+        # and the rod model then reproduces the FEM force (10 %: the target) where it
+        # misses it by up to 13.5 % otherwise
+        assert abs(row["force_rel_rod_nu0"]) <= TARGETS["force_rel"]
+
+
+def test_wrap_nominal_axis_is_the_rod_centerline(report):
+    wrap = report["scenes"]["wrap"]
+    levels = wrap["comparison"]["levels"]
+    assert len(levels) == 5  # T = 0.25 (k/6)^2 E D0^2, centroid approach <= 0.25: k = 1..5
+    for lv, cen in zip(levels, wrap["centroid_axis"], strict=True):
+        # the nominal axis's approach matches the rod's centerline (measured within
+        # 0.012 D0); the centroid's lags by up to 0.066 D0
+        assert abs(cen["fem_approach_nominal_over_d0"] - lv["rod_approach_over_d0"]) < 0.025
+        # its curvature too (measured +2 % to +8 %: the target, which is met)
+        assert abs(lv["curvature_rel"]) <= TARGETS["curvature_rel"]
+        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 3.3 points
+    # the centroid line bends far more at low tension (measured kappa D0 0.505 vs 0.184)
+    assert wrap["centroid_axis"][0]["fem_kappa_d0_centroid"] > 2.0 * levels[0]["fem_kappa_d0"]
 
 
 @pytest.mark.slow
@@ -86,8 +133,10 @@ def test_cli_crosscheck_writes_json(tmp_path):
     parser = argparse.ArgumentParser(prog="tightknot")
     register(parser.add_subparsers(dest="command"))
     out = tmp_path / "cc.json"
-    args = parser.parse_args(["fem", "crosscheck", "--json", str(out)])
+    # coarse: the default (medium) takes about 8 minutes on 2 cores
+    args = parser.parse_args(["fem", "crosscheck", "--mesh", "coarse", "--json", str(out)])
     code = args.handler(args)
     data = json.loads(out.read_text())
     assert code == (0 if data["passed"] else 1)
+    assert data["mesh"] == "coarse"
     assert data["fem_over_rod_time_ratio"] > 1.0

@@ -21,7 +21,7 @@ _FEM_EXAMPLES = """examples:
   tightknot fem squeeze --model 3d --ends free  # 3D segment with free ends
   tightknot fem indent --mesh coarse --no-convergence
   tightknot fem wrap --tension 0.25 --wrap-angle 90 --no-convergence
-  tightknot fem crosscheck --json out/crosscheck.json   # FEM versus rod model
+  tightknot fem crosscheck --json out/crosscheck.json   # FEM (medium) versus rod model
 """
 
 _CAL_EXAMPLES = """examples:
@@ -39,7 +39,9 @@ def register(subparsers: Any) -> None:
         epilog=_FEM_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     fem.add_argument("scene", help="squeeze | indent | wrap, or crosscheck (indent and wrap "
                                    "with the FEM and with the rod model, compared)")
-    fem.add_argument("--mesh", default="coarse", help="coarse | medium | fine")
+    fem.add_argument("--mesh", default=None,
+                     help="coarse | medium | fine (default: coarse for a scene, medium for "
+                          "crosscheck: the mesh the shipped law was calibrated on)")
     fem.add_argument("--approach", type=float, default=None,
                      help="squeeze, indent: total approach over D0, in (0, 1) (default 0.3)")
     fem.add_argument("--tension", type=float, default=None,
@@ -97,7 +99,8 @@ def _run_fem(args: argparse.Namespace) -> int:
     if args.ends is not None:
         options["ends"] = args.ends
     try:
-        result = run_scene(args.scene, mesh=args.mesh, max_approach_over_d0=args.approach,
+        result = run_scene(args.scene, mesh=args.mesh or "coarse",
+                           max_approach_over_d0=args.approach,
                            steps=args.steps, **options)
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))
@@ -119,9 +122,9 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
     if problem:
         return _fail(problem)
     try:
-        from .crosscheck import crosscheck
+        from .crosscheck import DEFAULT_MESH, crosscheck
 
-        report = crosscheck(mesh=args.mesh)
+        report = crosscheck(mesh=args.mesh or DEFAULT_MESH)
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))
     if args.json is None:

@@ -166,6 +166,10 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
         x = problem.positions()
         force, pressure = contact_nodal(contact, x, faces)
         f_side = 4.0 * float(force[:, 1].sum())  # x < 0 and z < 0 quarters of the patch
+        # axial force in the mid section (tension > 0): the z > 0 half of the rod is held
+        # by it against the contact forces' axial components (on the rod: -force), two
+        # indenters times two x halves
+        axial = 4.0 * float(-force[:, 2].sum())
         s_z, p_z = line_profile(contact, x, pressure, on_top, axis=2)
         s_x, p_x = line_profile(contact, x, pressure, on_mid, axis=0)
         a_z, a_x = edge_position(s_z, p_z), edge_position(s_x, p_x)
@@ -181,6 +185,7 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
             "mean_pressure_over_e": (f_side / (math.pi * a_x * a_z) / youngs_modulus
                                      if a_x * a_z > 0 else 0.0),
             "area_ratio_mid": area / area0,
+            "axial_force_mid_over_e_d0sq": axial / (youngs_modulus * diameter**2),
             "volume_ratio": volume_ratio(solid),
             "newton_iterations": int(problem.iterations[-1]) if problem.iterations else 0,
         }

@@ -30,6 +30,17 @@ see :mod:`tightknot.fem.overlap`):
   delta, with the stretched radius r0 lambda^(-nu), nu = 1/2 (incompressible), lambda the
   axial stretch of the centroid line at the mid section.
 
+Nominal axis (keys ``*_nominal``): the far fibre (the section's point opposite the
+contact, x = 0, y lowest) moved toward the cylinder along the far fibre's normal by the
+stretched radius r0 lambda^(-1/2) of the mid section: the centre of the circle that the
+rod model puts around its centerline, whose far side it keeps undeformed.
+``approach_nominal_over_d0`` is D0 minus its distance to the cylinder axis at z = 0,
+``kappa_d0_mid_nominal`` its Bergou curvature at z = 0 (the same 7-point stencil as the
+centroid's), ``force_per_length_mid_nominal`` the mid layer's contact force per length of
+it. The centroid line (``kappa_d0_mid``, ``force_per_length_mid``) bends more than this
+axis where the section flattens (see :mod:`tightknot.fem.crosscheck`). ``profile`` holds,
+per refined layer, the centroid, far and near fibres, nominal axis and line loads.
+
 Closed forms (key ``closed_form``; there is no Hertz formula for this conforming contact):
 the total contact force equals 2 T sin(theta) exactly (equilibrium of the whole rod with a
 frictionless cylinder), and where the bending moment is nearly constant along the wrap the
@@ -99,6 +110,9 @@ HEADLINE_KEYS = (
     "force_per_length_mid_over_e_d0",
     "peak_pressure_over_e",
     "kappa_d0_mid",
+    "approach_nominal_over_d0",
+    "force_per_length_mid_nominal_over_e_d0",
+    "kappa_d0_mid_nominal",
 )
 """Outputs compared across meshes (at the largest tension)."""
 
@@ -260,6 +274,9 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
     on_mid = np.isclose(pts[candidates, 2], 0.0)
     layer_of = np.rint(np.searchsorted(z, pts[candidates, 2] - 1e-12 * diameter)).astype(int)
     n_layers_fine = AXIAL_FINE_CELLS[level] + 1
+    sec = np.asarray(section.points)
+    i_bottom = int(np.argmin(np.hypot(sec[:, 0], sec[:, 1] + radius)))  # (0, -r)
+    i_top = int(np.argmin(np.hypot(sec[:, 0], sec[:, 1] - radius)))  # (0, r)
 
     def apply(tension: float) -> None:
         external[:] = np.outer(0.5 * tension * end_share, direction)
@@ -302,6 +319,23 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
         mirror = cent[1:4] * np.array([1.0, 1.0, -1.0])
         axis_pts = np.vstack([mirror[::-1], cent[:4]])
         kappa = float(bergou_curvature(axis_pts, closed=False)[3])
+        layers = np.arange(n_layers_fine) * ns
+        bottom = x[layers + i_bottom]
+        top_f = x[layers + i_top]
+        # nominal axis (the rod model's centerline, see the module docstring): the far
+        # fibre moved toward the cylinder by the stretched radius of the mid section (one
+        # value: N = T all along a frictionless wrap, so the stretch is uniform there; a
+        # radius per layer from the centroid line's lengths would carry the flattening's
+        # centroid shifts into the axis)
+        nominal = nominal_axis(bottom[:-1, 1:], np.full(n_layers_fine - 1, r_stretched))
+        seg_n = np.linalg.norm(np.diff(nominal, axis=0), axis=1)
+        trib_n = np.concatenate([[0.5 * seg_n[0]], 0.5 * (seg_n[:-1] + seg_n[1:])])
+        line_n = load[:-2] / trib_n
+        pts_n = np.column_stack([np.zeros(len(nominal)), nominal])
+        mirror_n = pts_n[1:4] * np.array([1.0, 1.0, -1.0])
+        kappa_n = float(bergou_curvature(np.vstack([mirror_n[::-1], pts_n[:4]]),
+                                         closed=False)[3])
+        d_n = axis_y - nominal[0, 0]
         f_mid = float(line[0])
         return {
             "tension": tension,
@@ -326,8 +360,23 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
             "contact_half_width_mid_over_d0": b_mid / diameter,
             "contact_half_length_over_d0": a_len / diameter,
             "kappa_d0_mid": kappa * diameter,
+            "approach_nominal_over_d0": (diameter - d_n) / diameter,
+            "force_per_length_mid_nominal": float(line_n[0]),
+            "force_per_length_mid_nominal_over_e_d0": float(line_n[0])
+            / (youngs_modulus * diameter),
+            "kappa_d0_mid_nominal": kappa_n * diameter,
             "volume_ratio": volume_ratio(solid),
             "newton_iterations": int(problem.iterations[-1]) if problem.iterations else 0,
+            "profile": {
+                "z_rest_over_d0": z[:n_layers_fine] / diameter,
+                "centroid_yz_over_d0": cent[:, 1:] / diameter,
+                "far_fibre_yz_over_d0": bottom[:, 1:] / diameter,
+                "near_fibre_yz_over_d0": top_f[:, 1:] / diameter,
+                "line_load_over_e_d0": line / (youngs_modulus * diameter),
+                "nominal_axis_yz_over_d0": nominal / diameter,
+                "line_load_nominal_over_e_d0": line_n / (youngs_modulus * diameter),
+                "cylinder_axis_y_over_d0": axis_y / diameter,
+            },
         }
 
     tensions = load_schedule(max_tension_over_e_d0sq * youngs_modulus * diameter**2, steps)
@@ -352,6 +401,21 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
                   "reason": "conforming wrap contact: no Hertz formula; see closed_form"},
         "wall_time_s": time.perf_counter() - start,
     }
+
+
+def nominal_axis(far_yz: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """Points (y, z) [m] of the nominal axis: each far-fibre point ``far_yz`` (first at
+    z = 0, ascending z) moved by ``radius`` [m] (per point) along the far fibre's unit
+    normal toward the cylinder (+y at z = 0). Tangents by central differences, the one at
+    z = 0 from the mirror image (it is e_z by symmetry), the last one-sided."""
+    far = np.asarray(far_yz, dtype=float)
+    t = np.empty_like(far)
+    t[0] = (0.0, 1.0)
+    t[1:-1] = far[2:] - far[:-2]
+    t[-1] = far[-1] - far[-2]
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    normal = np.column_stack([t[:, 1], -t[:, 0]])  # t turned by -90 degrees in (y, z)
+    return far + np.asarray(radius, dtype=float)[:, None] * normal
 
 
 def _polygon_area(points_2d: np.ndarray, quads: np.ndarray) -> float:
