@@ -84,6 +84,11 @@ class RodProblem:
         own = evaluator.rods[k].pattern
         if not np.array_equal(own.free_dofs, system.pattern.free_dofs):
             raise ValueError(f"rod {k}'s boundary conditions changed its free dofs")
+        m = system.model
+        # Dof maps, computed once (the model builds them on every access).
+        self._pos = m.position_dofs
+        self._edge_dof = m.edge_dof
+        self._free = system.pattern.free_dofs
         self.inertia: Inertia | None = None
         self.last_split = EnergySplit()
         self.trial: tuple[np.ndarray, ...] | None = None
@@ -111,10 +116,9 @@ class RodProblem:
         them by round-off only)."""
         s = self.system
         st = s.state
-        q = s.full_dofs()
-        q[s.pattern.free_dofs] = u
-        x = q[s.model.position_dofs]
-        theta = q[s.model.edge_dof] if s.model.twist else st.theta
+        q = self._dofs(u)
+        x = q[self._pos]
+        theta = q[self._edge_dof] if s.model.twist else st.theta
         c = self._cache
         if (c is not None and c[1] is s.rest and (c[2] is st.d1_ref or c[3].d1 is st.d1_ref)
                 and np.array_equal(c[0], u)):
@@ -132,7 +136,7 @@ class RodProblem:
             split.inertia = 0.5 * float(np.sum(w * dq * dq))
             grad = grad + w * dq
         self.last_split = split
-        free = s.pattern.free_dofs
+        free = self._free
         g_free = grad[free] if (want_grad or want_hess) else None
         h = None
         if want_hess:
@@ -146,10 +150,20 @@ class RodProblem:
 
     def max_step(self, u: np.ndarray, du: np.ndarray):
         """Largest step fraction the contact layer allows (yields the question)."""
-        x0 = self.system.positions(u)
-        dx = self.system.positions(u + du) - x0
+        x0 = self._dofs(u)[self._pos]
+        dx = self._dofs(u + du)[self._pos] - x0
         alpha = yield StepRequest(self.k, x0, dx)
         return alpha
+
+    def _dofs(self, u: np.ndarray) -> np.ndarray:
+        """All dofs of the state with the free ones from ``u`` (RodSystem's q)."""
+        st = self.system.state
+        q = np.empty(self.system.model.dof_count)
+        q[self._pos] = st.x
+        if self.system.model.twist:
+            q[self._edge_dof] = st.theta
+        q[self._free] = u
+        return q
 
     def accept(self, u: np.ndarray):
         """Make ``u`` the state (re-evaluated first if it was not the last trial)."""
