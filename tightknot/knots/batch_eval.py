@@ -168,10 +168,20 @@ class HessianData:
     data: np.ndarray
 
     def matrix(self, data: np.ndarray | None = None) -> sp.csc_matrix:
-        """The CSC matrix (with ``data`` instead of the evaluated entries if given)."""
+        """The CSC matrix (with ``data`` instead of the evaluated entries if given; the
+        evaluated one is built once)."""
         n = len(self.indptr) - 1
-        return sp.csc_matrix((self.data if data is None else data, self.indices,
-                              self.indptr), shape=(n, n))
+        if data is not None:
+            return sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
+        m = self.__dict__.get("_matrix")
+        if m is None:
+            m = sp.csc_matrix((self.data, self.indices, self.indptr), shape=(n, n))
+            object.__setattr__(self, "_matrix", m)
+        return m
+
+    def diagonal(self) -> np.ndarray:
+        """The diagonal entries (every one is stored)."""
+        return self.data[self.diag_slot]
 
 
 @dataclass

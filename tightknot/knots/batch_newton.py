@@ -38,7 +38,7 @@ from tightknot.knots.batch_eval import (
 from tightknot.knots.batch_linear import BandedCholesky, BandPlan, banded_lu_solve
 from tightknot.solvers.dynamic import ProximalResult
 from tightknot.solvers.linear import factorize
-from tightknot.solvers.newton import NewtonOptions, NewtonResult, _acceptable, _stalled
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, _stalled
 from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord
 from tightknot.solvers.system import EnergySplit, Inertia, RodSystem
 
@@ -251,11 +251,14 @@ def newton_gen(p: RodProblem, u0: np.ndarray, options: NewtonOptions | None = No
     for it in range(1, opt.max_iterations + 1):
         accepted = False
         h = hp.matrix()
-        diag = np.abs(h.diagonal())
+        diag = np.abs(hp.diagonal())
         diag = np.maximum(diag, 1e-12 * (diag.max() if diag.size else 1.0))
         while not accepted:
             d = p.shifted_direction(hp, g, mu, diag)
-            if d is None or not _acceptable(d, g, h, mu, diag):
+            # _acceptable of the Newton loop, keeping H d for the model decrease below.
+            hd = None if d is None else h @ d
+            if d is None or not (float(g @ d) < 0.0
+                                 and float(d @ hd) + mu * float(np.sum(diag * d * d)) > 0.0):
                 mu = opt.shift_initial if mu == 0.0 else mu * 10.0
                 if mu > opt.shift_max:
                     yield from p.accept(u)
@@ -285,7 +288,7 @@ def newton_gen(p: RodProblem, u0: np.ndarray, options: NewtonOptions | None = No
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
                                         history)
         du = alpha * d
-        predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ (h @ d)))
+        predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ hd))
         u = u + du
         step = p.system.step_norm(du)
         yield from p.accept(u)
