@@ -33,7 +33,7 @@ from tightknot.solvers.system import RodSystem
 TARGET_SPEEDUP = 5.0
 
 
-def _iteration_parts(system: RodSystem, repeats: int = 3) -> dict[str, float]:
+def _iteration_parts(system: RodSystem, repeats: int = 9) -> dict[str, float]:
     """Median times [s] of one evaluation with Hessian and one factorization + solve of a
     one-rod system (as :func:`tightknot.solvers.newton.newton_solve` does them)."""
     u = system.free_vector()
@@ -49,7 +49,7 @@ def _iteration_parts(system: RodSystem, repeats: int = 3) -> dict[str, float]:
     return {"evaluate_s": float(np.median(te)), "factorize_solve_s": float(np.median(tf))}
 
 
-def _batched_parts(batch: BatchResult, repeats: int = 3) -> dict[str, float]:
+def _batched_parts(batch: BatchResult, repeats: int = 9) -> dict[str, float]:
     """Median times [s] per rod of one batched evaluation of every rod with Hessian, and of
     each rod's factorization + solve (the batch's banded solver), at the final states."""
     ev = batch.evaluator
