@@ -22,15 +22,16 @@ positions; round-off changed the Newton iteration count of 19 of the 64 cases, b
 43 of 326, with 14 816 iterations in all against 14 794 one by one).
 
 What it buys on the CPU (``tightknot bench batch``, those 64 trefoils, 2 cores shared
-with other jobs): 1.9x and 2.2x in two runs over tying them one after another, 5.0 to 5.2
-against 9.8 to 11.0 ms per rod and Newton iteration. The rounds are those of the slowest
-rod (401); the launches, BVH builds and Python steps of an evaluation are paid once per
-round, so evaluation and step bounds cost 1.7 ms per rod-iteration. What batching cannot
-share stays per rod: the factorizations of each rod's 400-dof Newton system (2.2 ms per
-rod-iteration: 1.8 factorizations, more than half of them of indefinite matrices, which
-need LU; about what SuperLU costs the one-rod solver), the rods' own Python steps
-(0.9 ms) and the knot-type checks (0.1 ms). On a GPU the evaluation's share is where the
-gain lies; the linear solves would need a batched solver there too.
+with other jobs): 1.9x to 2.5x in four runs over tying them one after another (3.8 to 5.2
+against 9.5 to 11.5 ms per rod and Newton iteration; the target was 5x). The rounds are
+those of the slowest rod (401); the launches, BVH builds and Python steps of an evaluation
+are paid once per round, so evaluation and step bounds cost 1.3 to 1.9 ms per
+rod-iteration. What batching cannot share stays per rod: the factorizations of each
+rod's 400-dof Newton system (1.8 to 2.4 ms per rod-iteration: 1.8 factorizations, more
+than half of them of indefinite matrices, which need LU; about what SuperLU costs the
+one-rod solver), the rods' own Python steps (0.6 to 0.9 ms) and the knot-type checks
+(0.1 ms). On a GPU the evaluation's share is where the gain lies; the linear solves would
+need a batched solver there too.
 """
 
 from __future__ import annotations
