@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from tightknot.knots.batch import build_batch, tie_batch
-from tightknot.knots.batch_eval import BatchEvaluator, EvalRequest
+from tightknot.knots.batch import _layer_settings, build_batch, tie_batch
+from tightknot.knots.batch_eval import BatchEvaluator, EvalRequest, batch_contact_layer
 from tightknot.knots.batch_linear import (
     BandedCholesky,
     BandPlan,
@@ -17,6 +17,7 @@ from tightknot.knots.batch_linear import (
 )
 from tightknot.knots.scenes import closed_trefoil, gauge, open_trefoil
 from tightknot.knots.tie import tie
+from tightknot.rods.contact import ContactLayer
 from tightknot.solvers.linear import SparsePattern, factorize
 
 #: Small, different cases (a sweep of L0/D0): 48 vertices keep the test a few seconds.
@@ -165,6 +166,15 @@ def test_a_failed_rod_is_named():
     assert not batch.converged
     assert batch.failure.startswith("rod 0 (closed_trefoil, L0/D0 20)")
     assert "relax: Newton max_iterations" in batch.failure
+
+
+def test_batch_layer_keeps_the_scene_layer_settings():
+    sc = closed_trefoil(nodes=NODES)
+    like = ContactLayer(sc.model, sc.contact.law, gauss_points=3, hard_fraction=0.1,
+                        core_stiffness=2.0, local_thickness=True)
+    joint = build_batch([sc])
+    assert _layer_settings(batch_contact_layer(joint.model, like)) == _layer_settings(like)
+    assert _layer_settings(joint.contact) == _layer_settings(sc.contact)
 
 
 def test_bad_input():
