@@ -7,6 +7,15 @@ pulled along the axis by a dead force growing geometrically to the target, or mo
 target end-to-end distance. After every converged load step the knot type is checked
 (Alexander polynomial); a change stops the run as failed (physics.md sec. 2: a knot that
 passed through itself has failed).
+
+An open knot is kept centred on its rod: after the relaxation, after every converged load
+step but the last, and before every force of ``tie_to_lambda``, its material slides along
+the rod until the knot's centre is mid-rod (``recentre_open_knot``). Without friction the
+knot's place along the rod is a zero mode of the energy, and the short tails of the
+study's 185 mm knot (3.9 D0 each at Lambda_OC 15) leave no room for the drift that
+round-off otherwise steers (tests/knots/test_recentre.py). A rod with twist is not
+re-centred (its twist field would have to slide too). The returned equilibrium is always
+a converged solve; a slide is followed by one.
 """
 
 from __future__ import annotations
@@ -79,6 +88,10 @@ def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | No
                    "the knot slipped off an end, or the rod passed through itself")
             return (f"topology changed in phase {phase} at load t={rec.t:.4g}: knot type "
                     f"{kt}, expected {scene.knot_type} ({why})")
+        # The next load step starts from the knot centred on its rod (open knots); the
+        # last step's equilibrium is the phase's result and stays as it is.
+        if rec.t < 1.0 - 1e-12:
+            recentre_system(scene, system)
         return None
     return check
 
@@ -160,6 +173,7 @@ def tie(
     types.append(kt)
     if kt != scene.knot_type:
         return fail(f"relax: knot type {kt}, expected {scene.knot_type}", system, hold)
+    recentre_system(scene, system)
     if scene.closed:
         bcs = gauge(scene, positions=system.state.x)
     else:
@@ -191,14 +205,17 @@ def tie(
         return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                          hold if not scene.closed else 0.0, system)
 
-    # Phase 2: pull.
+    # Phase 2: pull. The end's force at the tightened equilibrium, then the knot centred
+    # on its rod.
+    f_end = end_reaction(system)
+    recentre_system(scene, system)
     state = system.state
     bcs = gauge(scene, positions=state.x)
     bcs.rest_length_scale((shrink, shrink))
     if pull_force is not None:
         # Start from the force the pinned end carried at the end of the tightening (a jump
         # down to a small dead load would release the knot, and it slips off the rod).
-        f0 = max(end_reaction(system), hold)
+        f0 = max(f_end, hold)
 
         def force_path(t: float) -> np.ndarray:
             return f0 * (pull_force / f0) ** t * axis
@@ -206,6 +223,7 @@ def tie(
         bcs.force(0, last, force_path)
         final_force = pull_force
     else:
+        # (after the re-centring, which moves the end by up to an edge's stretch change)
         d_now = float(np.linalg.norm(state.x[last] - state.x[0]))
         delta = end_distance - d_now
         bcs = gauge(scene, positions=state.x, sliding_end=False)
@@ -226,6 +244,103 @@ def tie(
         return fail(f"pull: {res.failure}", system, final_force, res.failed_state)
     return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                      final_force, system)
+
+
+def recentre_open_knot(scene: KnotScene, x: np.ndarray, rest: np.ndarray,
+                       tol: float = 0.05) -> tuple[np.ndarray, int]:
+    """Slide an open knot's material along the rod by whole edges so that the knot sits
+    mid-rod.
+
+    A frictionless knot on a uniform rod can sit anywhere along it: moving the rod's
+    material through the knot changes no energy while the tails are straight, so the
+    knot's position is a zero mode that Newton steps drift along with whatever asymmetry
+    round-off brings (measured: a 1e-9 D0 perturbation of the start left the loose 185 mm
+    knot 2 to 6 D0 off centre after the relaxation, and 2 of 4 such runs at 150 vertices,
+    3 of 3 at 300, slid off the shorter tail when loosened to Lambda_OC 15). The study's
+    knots sit mid-rod, so tie() puts them there. The knot's extent is the span of vertices
+    in contact (within ``tol`` of the nominal diameter); the material moves by the whole
+    number of edges k nearest to the rest arc between the knot's centre and the rod's
+    (``slide_material``: vertex i takes the place of vertex i - k, no interpolation, so
+    the knot's shape is kept exactly; an interpolated slide cuts the polyline's corners and
+    jammed a tight pull). Returns the new positions [m] and k (0: nothing moved).
+    """
+    from tightknot.knots.contact_map import contact_pairs
+
+    n = len(x)
+    i, j = contact_pairs(x, False, np.full(n, scene.diameter / 2.0), tol=tol)
+    if not len(i):
+        return x, 0
+    idx = np.r_[i, j]
+    arc = np.r_[0.0, np.cumsum(rest)]
+    delta = 0.5 * arc[-1] - 0.5 * (arc[idx.min()] + arc[idx.max()])
+    k = int(round(delta / float(np.mean(rest))))
+    if k == 0:
+        return x, 0
+    return slide_material(x, k), k
+
+
+def slide_material(x: np.ndarray, k: int) -> np.ndarray:
+    """Open centerline ``x`` [m] with its material moved by ``k`` edges along itself:
+    vertex i takes the place of vertex i - k (k > 0: toward the last end). The tail the
+    material leaves is extended straight along its end edge, the other is cut, and the
+    whole is translated so that the first vertex stays where it was. On a rod of equal
+    edges with straight tails this is an exact symmetry of the energy; the open scenes'
+    edges are equal to 0.1 % except the two at the tails' corners (chords of the rounded
+    corner: 4.5 % short at 150 vertices, 10 % at 90), which take a strain of that size
+    where the slide moves them."""
+    n = len(x)
+    if not (isinstance(k, (int, np.integer)) and abs(k) < n - 1):
+        raise ValueError(f"k must be a whole number with |k| < {n - 1}, got {k!r}")
+    if k == 0:
+        return x.copy()
+    y = np.empty_like(x)
+    if k > 0:
+        y[k:] = x[:n - k]
+        y[:k] = x[0] + (x[0] - x[1]) * np.arange(k, 0, -1)[:, None]
+    else:
+        m = -k
+        y[:n - m] = x[m:]
+        y[n - m:] = x[-1] + (x[-1] - x[-2]) * np.arange(1, m + 1)[:, None]
+    return y + (x[0] - y[0])
+
+
+def recentre_system(scene: KnotScene, system: RodSystem) -> int:
+    """Centre an open knot on its rod (``recentre_open_knot``) in place, keeping the
+    scene's gauge: the first vertex where it is, the last on the pull axis (e_x through
+    the first vertex) and the gauge vertex's z, which a rotation about the pull axis (a
+    zero mode as well) restores; a rotation that cannot (the new gauge vertex nearer the
+    axis than that z) leaves the knot where it is. A rod with twist keeps its place (its
+    twist field would have to slide with it). Returns the slide k [edges]."""
+    if scene.closed or scene.model.twist or scene.pull_axis is None:
+        return 0
+    if not np.allclose(scene.pull_axis, (1.0, 0.0, 0.0)):
+        return 0
+    x = system.state.x
+    y, k = recentre_open_knot(scene, x, system.rest)
+    if k == 0:
+        return 0
+    g = scene.info["gauge_vertex"]
+    p = y[g] - y[0]
+    zt = x[g, 2] - x[0, 2]
+    r = math.hypot(p[1], p[2])
+    if r <= abs(zt):
+        return 0
+    beta = math.atan2(p[2], p[1])
+    a = math.asin(zt / r)
+    # the smaller of the two rotations that put the gauge vertex back at its z
+    phi = min((a - beta, math.pi - a - beta),
+              key=lambda v: abs(math.remainder(v, 2.0 * math.pi)))
+    c, s_ = math.cos(phi), math.sin(phi)
+    q = y - y[0]
+    y = y.copy()
+    y[:, 1] = y[0, 1] + c * q[:, 1] - s_ * q[:, 2]
+    y[:, 2] = y[0, 2] + s_ * q[:, 1] + c * q[:, 2]
+    # The end stays on the pull axis where the gauge holds it (the slid tail is straight
+    # to round-off and ~1e-7 m of the tail's own sag: an end pinned at a given end-to-end
+    # distance must keep it exactly).
+    y[-1, 1:] = x[-1, 1:]
+    system.state = State.initial(scene.model, positions=y)
+    return k
 
 
 def end_reaction(system: RodSystem) -> float:
@@ -299,6 +414,7 @@ def tie_to_lambda(
 
     def solve_at(f: float) -> tuple[bool, float, str]:
         nonlocal iters
+        recentre_system(scene, pull)  # each force starts from the knot centred on its rod
         saved = pull.state.copy()
         saved_force = force[0]
         force[0] = f

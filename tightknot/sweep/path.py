@@ -142,8 +142,13 @@ class _Pull:
     def solve(self, f: float) -> str:
         """Equilibrium under force ``f`` [N] from the current state; "" on success, else
         the reason (the state is then put back)."""
+        from tightknot.knots.tie import recentre_system
         from tightknot.solvers.dynamic import proximal_relax
 
+        if recentre_system(self.scene, self.system) != 0:
+            # The knot was slid back to mid-rod (tie() explains): the last two equilibria
+            # no longer line up with the state, so no secant predictor from them.
+            self._previous = None
         saved = self.system.state.copy()
         if self.predictor:
             self._predict(f)
