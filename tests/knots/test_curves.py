@@ -65,3 +65,25 @@ def test_exclusion_window_ignores_tight_bend():
     arc = np.stack([0.5 * np.cos(t), 0.5 * np.sin(t), 0 * t], 1)
     d, _, _ = curves.min_nonlocal_distance(arc, False, curves.exclusion_arc_length(diam))
     assert not np.isfinite(d)
+
+
+def test_resample_equal_chords_gives_equal_edges_on_the_curve() -> None:
+    from tightknot.knots.curves import open_trefoil, resample_equal_chords
+
+    raw = open_trefoil(4000, 1.0, 3.0)  # tails of 3 size units, sharp corners
+    q = resample_equal_chords(raw, 150)
+    e = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    # Equal to round-off (each step solves |a + tau u - cur| = c; measured 1.3e-15).
+    assert np.ptp(e) <= 1e-12 * e.mean()
+    assert np.array_equal(q[0], raw[0])
+    # The last point stops short of the end by the bisection's tolerance (1e-13 of the
+    # length per step; measured 2e-10 of the curve's size).
+    assert np.linalg.norm(q[-1] - raw[-1]) <= 1e-8
+    # Every point lies on the polygon: within round-off of one of its segments.
+    a, b = raw[:-1], raw[1:]
+    u = b - a
+    t = np.clip(np.einsum("ijk,jk->ij", q[:, None] - a[None], u) / (u * u).sum(1), 0, 1)
+    dist = np.linalg.norm(q[:, None] - (a[None] + t[..., None] * u[None]), axis=2).min(1)
+    assert dist.max() <= 1e-12
+    with pytest.raises(ValueError, match="at least 2"):
+        resample_equal_chords(raw, 1)

@@ -18,10 +18,12 @@ def test_levels_along_one_path_and_an_unreachable_level_reported() -> None:
     # Visited from the weakest pull to the strongest.
     assert [lv["target"] for lv in levels] == [0.3, 3.0, 4.0]
     # 0.3 N cannot hold this frictionless knot: it slips off an end (measured: knot type
-    # 0_1 once the force falls near 1.4 N). That is a failed level, never an accepted one.
+    # 0_1 once the force falls near 1.4 N; with the knot kept centred, the slipping tail
+    # can instead come within 1e-10 of a strand, a type "undefined"). Either is a failed
+    # level, never an accepted one.
     slip = levels[0]
     assert not slip["reached"] and slip["summary"] is None
-    assert "knot type 0_1" in slip["failure"]
+    assert "knot type 0_1" in slip["failure"] or "knot type undefined" in slip["failure"]
     assert rec["status"] == "failed" and "pull_force = 0.3" in rec["failure"]
     # The path goes on from the last good equilibrium and reaches the other levels exactly.
     for lv in levels[1:]:
@@ -53,13 +55,13 @@ def test_the_tightest_level_of_a_path_is_the_tightest_level_alone() -> None:
     assert path["status"] == alone["status"] == "ok"
     a = path["result"]["levels"][-1]["summary"]
     b = alone["result"]["levels"][-1]["summary"]
-    # The knot may sit a fraction of an edge further along the rod (sliding along a
-    # frictionless rod is a soft mode: measured 0.4 D0 of centerline shift, the curvature
-    # peak one vertex over), so compare the knot's own measures. Measured differences:
-    # L/D 1e-6 relative, min gap 1e-5 D0, kappa D0 max 1e-4, Lambda_OC 7e-4; the bounds
-    # are ten times those, but far below the change from one force level to the next
+    # The knot is kept centred by whole edges (tie.recentre_open_knot), so the two runs
+    # can hold it at another fraction of an edge (0.16 D0 here): the edges' lattice then
+    # changes the knot's measures a little, so compare those, with bounds three times the
+    # measured differences (L/D 9e-5 relative, min gap 1.0e-3 D0, kappa D0 max 1.2e-3,
+    # Lambda_OC 1.6e-3), still far below the change from one force level to the next
     # (L/D 0.3 %, Lambda_OC 0.6 per 0.5 N).
-    assert math.isclose(a["L_over_D"], b["L_over_D"], rel_tol=1e-5)
-    assert math.isclose(a["min_gap_over_D0"], b["min_gap_over_D0"], abs_tol=1e-4)
-    assert math.isclose(a["kappa_D0_max"], b["kappa_D0_max"], abs_tol=1e-3)
+    assert math.isclose(a["L_over_D"], b["L_over_D"], rel_tol=3e-4)
+    assert math.isclose(a["min_gap_over_D0"], b["min_gap_over_D0"], abs_tol=3e-3)
+    assert math.isclose(a["kappa_D0_max"], b["kappa_D0_max"], abs_tol=4e-3)
     assert math.isclose(a["lambda_oc"], b["lambda_oc"], abs_tol=1e-2)

@@ -126,6 +126,78 @@ def resample_uniform(points: ArrayLike, n: int, closed: bool) -> NDArray[np.floa
     return np.stack([np.interp(targets, s, q[:, d]) for d in range(3)], axis=1)
 
 
+def resample_equal_chords(points: ArrayLike, n: int) -> NDArray[np.float64]:
+    """Resample an open polygon to ``n`` vertices with equal chords [m].
+
+    The vertices lie on the polygon, the first and last at its ends, and every edge has
+    the same length: the discretisation of a uniform rod whose rest lengths are its start's
+    edge lengths (``resample_uniform`` spaces the vertices equally in arc length instead,
+    so its chords fall short where the curve bends: 4.5 % at the tails' corners of a
+    150-vertex trefoil, which makes the rod non-uniform there). The chord c is found by
+    bisection so that n - 1 steps of length c, each to the first point of the polygon at
+    distance c from the last, end at the polygon's end (to 1e-12 of its length).
+    """
+    p = as_points(points)
+    if n < 2:
+        raise ValueError(f"n must be at least 2, got {n}")
+    lengths = edge_lengths(p, closed=False)
+    if np.any(lengths == 0):
+        p = p[np.concatenate([[True], lengths > 0])]
+        lengths = lengths[lengths > 0]
+    s = np.concatenate([[0.0], np.cumsum(lengths)])
+
+    def walk(c: float) -> tuple[NDArray[np.float64], float]:
+        # Returns the points and how much polygon arc is left after n - 1 steps (< 0:
+        # the walk ran off the end, by the missing steps' length).
+        out = np.empty((n, 3))
+        out[0] = p[0]
+        cur, j, t = p[0], 0, 0.0  # current point: on segment j at parameter t
+        for k in range(1, n):
+            # first vertex ahead at distance >= c from cur: the crossing is on the segment
+            # before it (or on segment j itself, past t)
+            # (looked for within 4 c of arc first: a chord of c spans at least c of arc,
+            # and on the knots' curves little more)
+            end = int(np.searchsorted(s, s[j] + t * lengths[j] + 4.0 * c)) + 1
+            d = np.linalg.norm(p[j + 1:end + 1] - cur, axis=1)
+            ahead = np.flatnonzero(d >= c)
+            if not ahead.size:
+                d = np.linalg.norm(p[j + 1:] - cur, axis=1)
+                ahead = np.flatnonzero(d >= c)
+            if not ahead.size:
+                return out, -(n - k) * c
+            jj = j + int(ahead[0])  # segment jj runs from p[jj] to p[jj + 1]
+            a, b = p[jj], p[jj + 1]
+            u = b - a
+            w = a - cur
+            # |w + tau u|^2 = c^2: the larger root (leaving the sphere; qc <= 0 inside),
+            # in the form without cancellation (Press et al., Numerical Recipes sec. 5.6)
+            qa, qb, qc = u @ u, 2.0 * (w @ u), w @ w - c * c
+            root = np.sqrt(max(qb * qb - 4.0 * qa * qc, 0.0))
+            tau = (2.0 * qc / (-qb - root) if qb > 0.0 and root + qb > 0.0
+                   else (-qb + root) / (2.0 * qa))
+            tau = min(max(tau, t if jj == j else 0.0), 1.0)
+            cur = a + tau * u
+            j, t = jj, tau
+            out[k] = cur
+        return out, float(s[-1] - (s[j] + t * lengths[j]))
+
+    lo, hi = 0.5 * s[-1] / (n - 1), s[-1] / (n - 1)  # chords never exceed the arc
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if walk(mid)[1] > 0.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-13 * s[-1]:
+            break
+    # The walk with the chord just short of the end: every step completed, every chord
+    # equal to round-off, the last point within n 1e-13 of the length before the end.
+    pts, left = walk(lo)
+    if not left >= 0.0:
+        raise RuntimeError("resample_equal_chords: the walk did not reach the end")
+    return pts
+
+
 def exclusion_arc_length(diameter: float) -> float:
     """Arc-length window [m] inside which pairs of centerline points are *local* (not contacts).
 

@@ -322,7 +322,9 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
         u = np.clip(depth / corner_window, 0.0, 1.0)
         w = (1.0 - u * u * (3.0 - 2.0 * u))[:, None]
         raw = w * smooth + (1.0 - w) * raw
-    pts = curves.resample_uniform(raw, int(nodes), closed=False)
+    # Equal edges: a uniform rod, on which sliding the material through the knot by whole
+    # edges is an exact symmetry (tie.recentre_open_knot relies on it).
+    pts = curves.resample_equal_chords(raw, int(nodes))
     length = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
     pts *= l0 / length
     # Pull axis on x: first end at the origin, last end on +x; the vertex farthest from the

@@ -35,6 +35,7 @@ from tightknot.knots.scenes import (
     gauge,
     vertex_radii,
 )
+from tightknot.rods.contact import SelfIntersectionError
 from tightknot.rods.state import State
 from tightknot.solvers.newton import NewtonOptions, newton_solve
 from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord, solve_static
@@ -72,9 +73,14 @@ class TieResult:
 
 
 def knot_type_of(scene: KnotScene, x: np.ndarray) -> str:
-    """Knot type of the centerline (open curves closed by a far-away arc)."""
+    """Knot type of the centerline (open curves closed by a far-away arc); "undefined"
+    when no projection of it is generic (strands within 1e-10 of its size: it passes
+    through itself, or nearly), which the topology checks then report as a change."""
     pts = x if scene.closed else topology.close_open_curve(x)
-    return topology.knot_type(pts)
+    try:
+        return topology.knot_type(pts)
+    except topology.TopologyError:
+        return "undefined (the curve nearly passes through itself)"
 
 
 def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | None):
@@ -284,10 +290,9 @@ def slide_material(x: np.ndarray, k: int) -> np.ndarray:
     vertex i takes the place of vertex i - k (k > 0: toward the last end). The tail the
     material leaves is extended straight along its end edge, the other is cut, and the
     whole is translated so that the first vertex stays where it was. On a rod of equal
-    edges with straight tails this is an exact symmetry of the energy; the open scenes'
-    edges are equal to 0.1 % except the two at the tails' corners (chords of the rounded
-    corner: 4.5 % short at 150 vertices, 10 % at 90), which take a strain of that size
-    where the slide moves them."""
+    edges (the open scenes', ``curves.resample_equal_chords``) with straight tails this is
+    an exact symmetry of the energy; where edges differ, each takes the strain of the
+    length of the place it moves to."""
     n = len(x)
     if not (isinstance(k, (int, np.integer)) and abs(k) < n - 1):
         raise ValueError(f"k must be a whole number with |k| < {n - 1}, got {k!r}")
@@ -339,6 +344,16 @@ def recentre_system(scene: KnotScene, system: RodSystem) -> int:
     # to round-off and ~1e-7 m of the tail's own sag: an end pinned at a given end-to-end
     # distance must keep it exactly).
     y[-1, 1:] = x[-1, 1:]
+    # The slide must not create what the run would fail on: a tail that is not straight
+    # (a knot slipping off an end curls it) is extended along its end edge, which can run
+    # it into other strands. Such a slide is not made.
+    if scene.contact is not None:
+        try:
+            scene.contact.check_no_intersection(y)
+        except SelfIntersectionError:
+            return 0
+    if knot_type_of(scene, y) != knot_type_of(scene, x):
+        return 0
     system.state = State.initial(scene.model, positions=y)
     return k
 
