@@ -309,41 +309,51 @@ def slide_material(x: np.ndarray, k: int) -> np.ndarray:
     return y + (x[0] - y[0])
 
 
-def recentre_system(scene: KnotScene, system: RodSystem) -> int:
+def recentre_system(scene: KnotScene, system: RodSystem
+                    ) -> tuple[int, Callable[[np.ndarray], np.ndarray] | None]:
     """Centre an open knot on its rod (``recentre_open_knot``) in place, keeping the
     scene's gauge: the first vertex where it is, the last on the pull axis (e_x through
     the first vertex) and the gauge vertex's z, which a rotation about the pull axis (a
     zero mode as well) restores; a rotation that cannot (the new gauge vertex nearer the
     axis than that z) leaves the knot where it is. A rod with twist keeps its place (its
-    twist field would have to slide with it). Returns the slide k [edges]."""
+    twist field would have to slide with it).
+
+    Returns the slide k [edges] and the map that applies the same slide and rotation to
+    other positions of the rod (e.g. an earlier equilibrium a predictor extrapolates
+    from), or (0, None) when nothing moved."""
     if scene.closed or scene.model.twist or scene.pull_axis is None:
-        return 0
+        return 0, None
     if not np.allclose(scene.pull_axis, (1.0, 0.0, 0.0)):
-        return 0
+        return 0, None
     x = system.state.x
-    y, k = recentre_open_knot(scene, x, system.rest)
+    y0, k = recentre_open_knot(scene, x, system.rest)
     if k == 0:
-        return 0
+        return 0, None
     g = scene.info["gauge_vertex"]
-    p = y[g] - y[0]
+    p = y0[g] - y0[0]
     zt = x[g, 2] - x[0, 2]
     r = math.hypot(p[1], p[2])
     if r <= abs(zt):
-        return 0
+        return 0, None
     beta = math.atan2(p[2], p[1])
     a = math.asin(zt / r)
     # the smaller of the two rotations that put the gauge vertex back at its z
     phi = min((a - beta, math.pi - a - beta),
               key=lambda v: abs(math.remainder(v, 2.0 * math.pi)))
     c, s_ = math.cos(phi), math.sin(phi)
-    q = y - y[0]
-    y = y.copy()
-    y[:, 1] = y[0, 1] + c * q[:, 1] - s_ * q[:, 2]
-    y[:, 2] = y[0, 2] + s_ * q[:, 1] + c * q[:, 2]
-    # The end stays on the pull axis where the gauge holds it (the slid tail is straight
-    # to round-off and ~1e-7 m of the tail's own sag: an end pinned at a given end-to-end
-    # distance must keep it exactly).
-    y[-1, 1:] = x[-1, 1:]
+
+    def transform(z: np.ndarray) -> np.ndarray:
+        w = slide_material(z, k)
+        q = w - w[0]
+        w[:, 1] = w[0, 1] + c * q[:, 1] - s_ * q[:, 2]
+        w[:, 2] = w[0, 2] + s_ * q[:, 1] + c * q[:, 2]
+        # The end stays on the pull axis where the gauge holds it (the slid tail is
+        # straight to round-off and ~1e-7 m of the tail's own sag: an end pinned at a
+        # given end-to-end distance must keep it exactly).
+        w[-1, 1:] = z[-1, 1:]
+        return w
+
+    y = transform(x)
     # The slide must not create what the run would fail on: a tail that is not straight
     # (a knot slipping off an end curls it) is extended along its end edge, which can run
     # it into other strands. Such a slide is not made.
@@ -351,11 +361,11 @@ def recentre_system(scene: KnotScene, system: RodSystem) -> int:
         try:
             scene.contact.check_no_intersection(y)
         except SelfIntersectionError:
-            return 0
+            return 0, None
     if knot_type_of(scene, y) != knot_type_of(scene, x):
-        return 0
+        return 0, None
     system.state = State.initial(scene.model, positions=y)
-    return k
+    return k, transform
 
 
 def end_reaction(system: RodSystem) -> float:

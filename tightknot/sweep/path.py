@@ -145,10 +145,11 @@ class _Pull:
         from tightknot.knots.tie import recentre_system
         from tightknot.solvers.dynamic import proximal_relax
 
-        if recentre_system(self.scene, self.system) != 0:
-            # The knot was slid back to mid-rod (tie() explains): the last two equilibria
-            # no longer line up with the state, so no secant predictor from them.
-            self._previous = None
+        _, moved = recentre_system(self.scene, self.system)
+        if moved is not None and self._previous is not None:
+            # The knot was slid back to mid-rod (tie() explains): the previous equilibrium
+            # takes the same slide, so that the secant predictor still pairs like vertices.
+            self._previous = (self._previous[0], moved(self._previous[1]))
         saved = self.system.state.copy()
         if self.predictor:
             self._predict(f)
