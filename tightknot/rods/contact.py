@@ -221,6 +221,17 @@ class ContactLayer:
         self._count = wp.zeros(1, dtype=wp.int32, device=self.device)
 
     def _arcs(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
+        # Rest arcs change once per load step but are asked for at every evaluation and
+        # step bound (a Python loop over the rods and two device copies each time): reused
+        # while the rest lengths are the same.
+        memo = getattr(self, "_arcs_memo", None)
+        if memo is not None and np.array_equal(memo[0], rest):
+            return memo[1]
+        out = self._arcs_of(rest)
+        self._arcs_memo = (np.array(rest, dtype=np.float64), out)
+        return out
+
+    def _arcs_of(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
         m = self.model
         arcs = np.zeros((m.edge_count, 2))
         lengths = np.zeros(len(m.rods))
