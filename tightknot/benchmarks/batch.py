@@ -20,13 +20,13 @@ import time
 
 import numpy as np
 
+from tightknot.benchmarks.der import newton_iteration_parts
 from tightknot.knots.batch import BatchResult, tie_batch
 from tightknot.knots.batch_eval import EvalRequest
 from tightknot.knots.batch_linear import single_blas_thread
 from tightknot.knots.batch_newton import RodProblem
 from tightknot.knots.scenes import closed_trefoil
 from tightknot.knots.tie import tie
-from tightknot.solvers.linear import factorize
 from tightknot.solvers.system import RodSystem
 
 #: The issue's target: 64 trefoils of 100 vertices batched >= 5x faster than sequential.
@@ -36,17 +36,8 @@ TARGET_SPEEDUP = 5.0
 def _iteration_parts(system: RodSystem, repeats: int = 9) -> dict[str, float]:
     """Median times [s] of one evaluation with Hessian and one factorization + solve of a
     one-rod system (as :func:`tightknot.solvers.newton.newton_solve` does them)."""
-    u = system.free_vector()
-    te, tf = [], []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        _, g, h = system.evaluate(u, True, True)
-        t1 = time.perf_counter()
-        factorize(h).solve(-g)
-        t2 = time.perf_counter()
-        te.append(t1 - t0)
-        tf.append(t2 - t1)
-    return {"evaluate_s": float(np.median(te)), "factorize_solve_s": float(np.median(tf))}
+    evaluate_s, solve_s = newton_iteration_parts(system, repeats)
+    return {"evaluate_s": evaluate_s, "factorize_solve_s": solve_s}
 
 
 def _batched_parts(batch: BatchResult, repeats: int = 9) -> dict[str, float]:

@@ -41,8 +41,16 @@ def iteration_time(n: int, repeats: int = 5, device: str = "cpu") -> dict:
     bcs = BoundaryConditions(model).clamp(0, "start").force(0, -1, [0.0, 0.0, -1e-3])
     system = RodSystem(model, State.initial(model), bcs)
     system.set_load(1.0)
+    system.evaluate(system.free_vector())  # warm-up (kernel load, allocations)
+    a, s = newton_iteration_parts(system, repeats)
+    return {"vertices": n, "newton_iteration_s": a + s, "assembly_s": a, "solve_s": s}
+
+
+def newton_iteration_parts(system: RodSystem, repeats: int) -> tuple[float, float]:
+    """Median times [s] of the two parts of one Newton iteration at the system's state,
+    as :func:`tightknot.solvers.newton.newton_solve` does them: the evaluation with
+    Hessian, and the factorization + solve."""
     u = system.free_vector()
-    system.evaluate(u)  # warm-up (kernel load, allocations)
     ta, ts = [], []
     for _ in range(repeats):
         t0 = time.perf_counter()
@@ -52,8 +60,7 @@ def iteration_time(n: int, repeats: int = 5, device: str = "cpu") -> dict:
         t2 = time.perf_counter()
         ta.append(t1 - t0)
         ts.append(t2 - t1)
-    a, s = float(np.median(ta)), float(np.median(ts))
-    return {"vertices": n, "newton_iteration_s": a + s, "assembly_s": a, "solve_s": s}
+    return float(np.median(ta)), float(np.median(ts))
 
 
 _STARTUP = (

@@ -54,29 +54,21 @@ class BatchContactLayer(ContactLayer):
     _reuse: bool = False
     _store: bool = False
 
-    _arcs_cache: tuple[np.ndarray, tuple[wp.array, wp.array]] | None = None
-
-    def _arcs(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
-        # The base class loops over the rods (64 rods: about 1 ms, several times a round).
+    def _arcs_of(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
+        # The base class loops over the rods (64 rods: about 1 ms, each time the rest
+        # lengths change; ContactLayer._arcs reuses the result while they do not).
         # Rods of one edge count: one cumulative sum along each row of a (rods, edges)
-        # view, the same additions in the same order as the loop. Reused while the rest
-        # lengths are unchanged (within a round).
-        c = self._arcs_cache
-        if c is not None and np.array_equal(c[0], rest):
-            return c[1]
+        # view, the same additions in the same order as the loop.
         m = self.model
         counts = {r.edge_count for r in m.rods}
         if len(counts) != 1:
-            out = super()._arcs(rest)
-        else:
-            le = np.ascontiguousarray(rest, dtype=np.float64).reshape(len(m.rods), -1)
-            s1 = np.cumsum(le, axis=1)
-            arcs = np.stack([(s1 - le).ravel(), s1.ravel()], axis=1)
-            out = (wp.array(arcs, dtype=wp.vec2d, device=self.device),
-                   wp.array(np.ascontiguousarray(s1[:, -1]), dtype=wp.float64,
-                            device=self.device))
-        self._arcs_cache = (np.array(rest, dtype=np.float64), out)
-        return out
+            return super()._arcs_of(rest)
+        le = np.ascontiguousarray(rest, dtype=np.float64).reshape(len(m.rods), -1)
+        s1 = np.cumsum(le, axis=1)
+        arcs = np.stack([(s1 - le).ravel(), s1.ravel()], axis=1)
+        return (wp.array(arcs, dtype=wp.vec2d, device=self.device),
+                wp.array(np.ascontiguousarray(s1[:, -1]), dtype=wp.float64,
+                         device=self.device))
 
     def _candidates(self, wx: wp.array, wdx: wp.array, margin: wp.array, arcs: wp.array,
                     rod_len: wp.array) -> wp.array:

@@ -362,7 +362,8 @@ def recentre_system(scene: KnotScene, system: RodSystem
             scene.contact.check_no_intersection(y)
         except SelfIntersectionError:
             return 0, None
-    if knot_type_of(scene, y) != knot_type_of(scene, x):
+    # (every caller slides an accepted state, whose type is the scene's)
+    if knot_type_of(scene, y) != scene.knot_type:
         return 0, None
     system.state = State.initial(scene.model, positions=y)
     return k, transform

@@ -207,6 +207,8 @@ class ContactLayer:
         #: Edge rest lengths of the last evaluation (the load path changes them): the
         #: exclusion window of the step bound and of the checks is measured with these.
         self.rest = model.edge_rest_length.copy()
+        #: (rest lengths, their arc tables) of the last ``_arcs`` call.
+        self._arcs_memo: tuple[np.ndarray, tuple[wp.array, wp.array]] | None = None
         # Placeholders for the kernel's unused Hessian targets.
         self._no_tables = (wp.full(1, -1, dtype=wp.int64, device=dev),
                            wp.zeros(model.vertex_count + 1, dtype=wp.int32, device=dev),
@@ -224,7 +226,7 @@ class ContactLayer:
         # Rest arcs change once per load step but are asked for at every evaluation and
         # step bound (a Python loop over the rods and two device copies each time): reused
         # while the rest lengths are the same.
-        memo = getattr(self, "_arcs_memo", None)
+        memo = self._arcs_memo
         if memo is not None and np.array_equal(memo[0], rest):
             return memo[1]
         out = self._arcs_of(rest)
