@@ -252,8 +252,13 @@ def tie(
                      final_force, system)
 
 
+#: A vertex belongs to the knot when a non-local one is within (1 + this) of the nominal
+#: diameter (a margin of 5 % finds the loose knots' strands too).
+KNOT_EXTENT_TOL = 0.05
+
+
 def recentre_open_knot(scene: KnotScene, x: np.ndarray, rest: np.ndarray,
-                       tol: float = 0.05) -> tuple[np.ndarray, int]:
+                       tol: float = KNOT_EXTENT_TOL) -> tuple[np.ndarray, int]:
     """Slide an open knot's material along the rod by whole edges so that the knot sits
     mid-rod.
 
@@ -270,19 +275,22 @@ def recentre_open_knot(scene: KnotScene, x: np.ndarray, rest: np.ndarray,
     the knot's shape is kept exactly; an interpolated slide cuts the polyline's corners and
     jammed a tight pull). Returns the new positions [m] and k (0: nothing moved).
     """
+    k = _knot_offset(scene, x, rest, tol)
+    return (x, 0) if k == 0 else (slide_material(x, k), k)
+
+
+def _knot_offset(scene: KnotScene, x: np.ndarray, rest: np.ndarray, tol: float) -> int:
+    """Whole edges k that bring the knot's centre (middle of the span of vertices in
+    contact within ``tol``) to the rod's middle; 0 without contact."""
     from tightknot.knots.contact_map import contact_pairs
 
-    n = len(x)
-    i, j = contact_pairs(x, False, np.full(n, scene.diameter / 2.0), tol=tol)
+    i, j = contact_pairs(x, False, np.full(len(x), scene.diameter / 2.0), tol=tol)
     if not len(i):
-        return x, 0
+        return 0
     idx = np.r_[i, j]
     arc = np.r_[0.0, np.cumsum(rest)]
     delta = 0.5 * arc[-1] - 0.5 * (arc[idx.min()] + arc[idx.max()])
-    k = int(round(delta / float(np.mean(rest))))
-    if k == 0:
-        return x, 0
-    return slide_material(x, k), k
+    return int(round(delta / float(np.mean(rest))))
 
 
 def slide_material(x: np.ndarray, k: int) -> np.ndarray:
@@ -326,9 +334,10 @@ def recentre_system(scene: KnotScene, system: RodSystem
     if not np.allclose(scene.pull_axis, (1.0, 0.0, 0.0)):
         return 0, None
     x = system.state.x
-    y0, k = recentre_open_knot(scene, x, system.rest)
+    k = _knot_offset(scene, x, system.rest, KNOT_EXTENT_TOL)
     if k == 0:
         return 0, None
+    y0 = slide_material(x, k)
     g = scene.info["gauge_vertex"]
     p = y0[g] - y0[0]
     zt = x[g, 2] - x[0, 2]
@@ -342,8 +351,8 @@ def recentre_system(scene: KnotScene, system: RodSystem
               key=lambda v: abs(math.remainder(v, 2.0 * math.pi)))
     c, s_ = math.cos(phi), math.sin(phi)
 
-    def transform(z: np.ndarray) -> np.ndarray:
-        w = slide_material(z, k)
+    def turn(w: np.ndarray, z: np.ndarray) -> np.ndarray:
+        # slid positions w of z, rotated about the pull axis through their first vertex
         q = w - w[0]
         w[:, 1] = w[0, 1] + c * q[:, 1] - s_ * q[:, 2]
         w[:, 2] = w[0, 2] + s_ * q[:, 1] + c * q[:, 2]
@@ -353,7 +362,10 @@ def recentre_system(scene: KnotScene, system: RodSystem
         w[-1, 1:] = z[-1, 1:]
         return w
 
-    y = transform(x)
+    def transform(z: np.ndarray) -> np.ndarray:
+        return turn(slide_material(z, k), z)
+
+    y = turn(y0, x)
     # The slide must not create what the run would fail on: a tail that is not straight
     # (a knot slipping off an end curls it) is extended along its end edge, which can run
     # it into other strands. Such a slide is not made.
