@@ -52,8 +52,6 @@ from tightknot.knots.batch_newton import (
     LinearStats,
     LockstepStats,
     RodProblem,
-    continuation_gen,
-    newton_gen,
     run_lockstep,
 )
 from tightknot.knots.scenes import KnotScene, gauge
@@ -63,8 +61,8 @@ from tightknot.rods.builder import RodBuilder
 from tightknot.rods.contact import ContactLayer
 from tightknot.rods.model import Model
 from tightknot.solvers.linear import SparsePattern
-from tightknot.solvers.newton import NewtonOptions
-from tightknot.solvers.static import StaticResult, StepRecord
+from tightknot.solvers.newton import NewtonOptions, newton_gen
+from tightknot.solvers.static import StaticResult, StepRecord, continuation_gen
 from tightknot.solvers.system import RodSystem
 
 #: Gap between the bounding boxes of two copies, in rest diameters: far beyond the

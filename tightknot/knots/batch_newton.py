@@ -3,28 +3,24 @@
 :func:`tightknot.knots.tie.tie` ties a closed knot by a Newton relaxation, then a load
 continuation (:func:`tightknot.solvers.static.solve_static`) whose failed steps are
 retried by proximal steps (:func:`tightknot.solvers.dynamic.proximal_relax`), each step a
-damped Newton solve (:func:`tightknot.solvers.newton.newton_solve`). Here the same logic
-runs for every rod, with the rod's own load parameter, step length, shift, line search and
-convergence test, written as a generator that yields each question it has about its
-potential (an energy, gradient and Hessian, or a collision-free step bound) instead of
-evaluating it. :func:`run_lockstep` collects the pending questions of all rods and answers
-them together (:class:`tightknot.knots.batch_eval.BatchEvaluator`: one set of launches),
-so a rod that is done costs nothing and no rod waits for another's load step. A rod
-therefore follows its own tie's path, up to the round-off of the joint evaluation (sums in
-another order) and of the linear solve (banded Cholesky where the matrix is positive
-definite, banded LU otherwise, :mod:`tightknot.knots.batch_linear`, where the one-rod
-solver uses SuperLU).
-
-The generators mirror the owner's solvers line by line (same options, same tests, same
-messages); a change there must be made here too (``tests/knots/test_batch.py`` compares
-each rod with its own tie).
+damped Newton solve (:func:`tightknot.solvers.newton.newton_solve`). Those solvers are
+generators (``newton_gen``, ``proximal_gen``, ``continuation_gen``) that yield each
+question they have about the potential (an energy, gradient and Hessian, or a
+collision-free step bound) instead of evaluating it; one rod alone answers at once. Here
+every rod of a batch runs the same generators, with its own load parameter, step length,
+shift, line search and convergence test, through a :class:`RodProblem`, and
+:func:`run_lockstep` collects the pending questions of all rods and answers them together
+(:class:`tightknot.knots.batch_eval.BatchEvaluator`: one set of launches), so a rod that
+is done costs nothing and no rod waits for another's load step. A rod therefore follows
+its own tie's path, up to the round-off of the joint evaluation (sums in another order)
+and of the linear solve (banded Cholesky where the matrix is positive definite, banded LU
+otherwise, :mod:`tightknot.knots.batch_linear`, where the one-rod solver uses SuperLU;
+``tests/knots/test_batch.py`` compares each rod with its own tie).
 """
-
 from __future__ import annotations
 
-import math
 import time
-from collections.abc import Callable, Generator
+from collections.abc import Generator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,10 +32,7 @@ from tightknot.knots.batch_eval import (
     StepRequest,
 )
 from tightknot.knots.batch_linear import BandedCholesky, BandPlan, banded_lu_solve
-from tightknot.solvers.dynamic import ProximalResult
 from tightknot.solvers.linear import factorize
-from tightknot.solvers.newton import NewtonOptions, NewtonResult, _stalled
-from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord
 from tightknot.solvers.system import EnergySplit, Inertia, RodSystem
 
 #: What a rod's generator yields (a question) and is sent back (the answer).
@@ -179,6 +172,33 @@ class RodProblem:
         """As RodSystem.energy_roundoff [J]."""
         return 1e-13 * self.last_split.magnitude
 
+    def residual_norm(self, g: np.ndarray) -> float:
+        """As RodSystem.residual_norm [-]."""
+        return self.system.residual_norm(g)
+
+    def step_norm(self, du: np.ndarray) -> float:
+        """As RodSystem.step_norm [-]."""
+        return self.system.step_norm(du)
+
+    @property
+    def handle(self) -> RodProblem:
+        """What a continuation's predictor is given: this rod (its ``set_load`` tells the
+        evaluator the new rest lengths)."""
+        return self
+
+    def set_inertia(self, inertia: Inertia | None) -> None:
+        """The proximal steps' inertia term (added in :meth:`evaluate`)."""
+        self.inertia = inertia
+
+    @staticmethod
+    def matrix(h: HessianData) -> object:
+        """The Hessian as a sparse matrix (for products)."""
+        return h.matrix()
+
+    @staticmethod
+    def diagonal(h: HessianData) -> np.ndarray:
+        return h.diagonal()
+
     # -- linear algebra ----------------------------------------------------------------------
     def shifted_direction(self, h: HessianData, g: np.ndarray, mu: float,
                           diag: np.ndarray) -> np.ndarray | None:
@@ -228,188 +248,6 @@ class RodProblem:
             if d is None:  # exactly singular
                 return None
         return d if np.isfinite(d).all() else None
-
-
-def newton_gen(p: RodProblem, u0: np.ndarray, options: NewtonOptions | None = None):
-    """:func:`tightknot.solvers.newton.newton_solve` for one rod of the batch."""
-    opt = options or NewtonOptions()
-    u = np.array(u0, dtype=np.float64)
-    energy, g, hp = yield from p.evaluate(u, True, True)
-    if not (math.isfinite(energy) and np.isfinite(g).all()):
-        return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
-    res = p.system.residual_norm(g)
-    if not math.isfinite(res):
-        return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
-    history = [res]
-    mu = 0.0
-    step = math.inf
-    if res <= opt.residual_tol:
-        yield from p.accept(u)
-        return NewtonResult(True, 0, res, 0.0, energy, "converged", history)
-    best = [res]
-    energies = [energy]
-    for it in range(1, opt.max_iterations + 1):
-        accepted = False
-        h = hp.matrix()
-        diag = np.abs(hp.diagonal())
-        diag = np.maximum(diag, 1e-12 * (diag.max() if diag.size else 1.0))
-        while not accepted:
-            d = p.shifted_direction(hp, g, mu, diag)
-            # _acceptable of the Newton loop, keeping H d for the model decrease below.
-            hd = None if d is None else h @ d
-            if d is None or not (float(g @ d) < 0.0
-                                 and float(d @ hd) + mu * float(np.sum(diag * d * d)) > 0.0):
-                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
-                if mu > opt.shift_max:
-                    yield from p.accept(u)
-                    return NewtonResult(False, it, res, step, energy, "line_search_failed",
-                                        history)
-                continue
-            alpha = min(1.0, (yield from p.max_step(u, d)))
-            slope = float(g @ d)
-            roundoff = p.energy_roundoff()
-            for _ in range(opt.max_backtracks):
-                trial = u + alpha * d
-                e_trial, _, _ = yield from p.evaluate(trial, False, False)
-                if not math.isfinite(e_trial):
-                    alpha *= 0.5
-                    continue
-                if e_trial <= energy + opt.armijo * alpha * slope:
-                    accepted = True
-                    break
-                if -alpha * slope <= roundoff and e_trial <= energy + roundoff:
-                    accepted = True
-                    break
-                alpha *= 0.5
-            if not accepted:
-                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
-                if mu > opt.shift_max:
-                    yield from p.accept(u)
-                    return NewtonResult(False, it, res, step, energy, "line_search_failed",
-                                        history)
-        du = alpha * d
-        predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ hd))
-        u = u + du
-        step = p.system.step_norm(du)
-        yield from p.accept(u)
-        e_old = energy
-        energy, g, hp = yield from p.evaluate(u, True, True)
-        if not (math.isfinite(energy) and np.isfinite(g).all()):
-            return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
-        res = p.system.residual_norm(g)
-        if not math.isfinite(res):
-            return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
-        history.append(res)
-        ratio = (e_old - energy) / predicted if predicted > 0 else 1.0
-        if alpha < 0.5 or ratio < 0.25:
-            mu = max(4.0 * mu, opt.shift_trust)
-        elif alpha == 1.0 and ratio > 0.75:
-            mu = 0.0 if mu <= opt.shift_trust else mu / 4.0
-        if res <= opt.residual_tol:
-            return NewtonResult(True, it, res, step, energy, "converged", history)
-        if step <= opt.step_tol and res > opt.stall_factor * history[-2]:
-            return NewtonResult(False, it, res, step, energy, "stagnated", history)
-        best.append(min(best[-1], res))
-        energies.append(energy)
-        if _stalled(best, energies, opt, p.energy_roundoff()):
-            return NewtonResult(False, it, res, step, energy, "stalled", history)
-    return NewtonResult(False, opt.max_iterations, res, step, energy, "max_iterations", history)
-
-
-def proximal_gen(p: RodProblem, dt: float = 1e-3, max_steps: int = 200,
-                 options: NewtonOptions | None = None, grow_below: int = 8):
-    """:func:`tightknot.solvers.dynamic.proximal_relax` for one rod of the batch."""
-    s = p.system
-    if not (s.model.vertex_mass > 0).all():
-        raise ValueError("proximal relaxation needs density > 0 for every rod")
-    opts = options or NewtonOptions()
-    iters = 0
-    for k in range(1, max_steps + 1):
-        saved = s.state.copy()
-        p.inertia = Inertia(dt=dt, q_hat=s.full_dofs(), mass=s.dof_mass)
-        try:
-            res = yield from newton_gen(p, s.free_vector(), opts)
-        finally:
-            p.inertia = None
-        iters += res.iterations
-        if not res.converged:
-            s.state = saved
-            dt *= 0.25
-            continue
-        if res.iterations < grow_below:
-            dt *= 2.0
-        static = yield from newton_gen(
-            p, s.free_vector(), NewtonOptions(residual_tol=opts.residual_tol, max_iterations=15))
-        iters += static.iterations
-        if static.converged:
-            return ProximalResult(True, k, iters, "converged")
-    return ProximalResult(False, max_steps, iters, "max_steps")
-
-
-StepCheck = Callable[[RodSystem, StepRecord], str | None]
-Predictor = Callable[[RodProblem, float, float], None]
-
-
-def continuation_gen(p: RodProblem, opt: ContinuationOptions, callback: StepCheck | None,
-                     predictor: Predictor | None):
-    """:func:`tightknot.solvers.static.solve_static` (from t = 0) for one rod."""
-    s = p.system
-    start = time.perf_counter()
-    t = 0.0
-    dt = min(opt.max_step, 1.0 / opt.steps)
-    records: list[StepRecord] = []
-    total_iters = 0
-    while t < 1.0 - 1e-14:
-        t_next = min(1.0, t + dt)
-        saved = s.state.copy()
-        p.set_load(t_next)
-        if predictor is not None:
-            predictor(p, t, t_next)
-        res = yield from newton_gen(p, s.free_vector(), opt.newton)
-        total_iters += res.iterations
-        if not res.converged and opt.proximal_dt is not None:
-            prox = yield from proximal_gen(p, opt.proximal_dt, opt.proximal_steps, opt.newton)
-            total_iters += prox.newton_iterations
-            if prox.converged:
-                _, g, _ = yield from p.evaluate(s.free_vector(), True, False)
-                res = NewtonResult(True, res.iterations + prox.newton_iterations,
-                                   s.residual_norm(g), 0.0, p.last_split.total,
-                                   "converged_by_proximal_steps", res.history)
-        where = f"load step {len(records) + 1} (from t={t:.6g} to t={t_next:.6g})"
-        if not res.converged:
-            failed = s.state.copy()
-            s.state = saved
-            p.set_load(t)
-            dt *= 0.5
-            why = None
-            if dt < opt.min_step:
-                why = f"step halved below min_step={opt.min_step:g}"
-            elif opt.max_newton_iterations is not None and \
-                    total_iters >= opt.max_newton_iterations:
-                why = f"Newton budget of {opt.max_newton_iterations} iterations spent"
-            if why is not None:
-                return StaticResult(
-                    False, t, records, total_iters,
-                    f"Newton {res.reason} (residual {res.residual:.3g}) at {where}; {why}",
-                    time.perf_counter() - start, failed)
-            continue
-        rec = StepRecord(t_next, res)
-        records.append(rec)
-        t = t_next
-        if callback is not None:
-            reason = callback(s, rec)
-            if reason:
-                return StaticResult(False, t, records, total_iters, f"{reason} [{where}]",
-                                    time.perf_counter() - start, s.state.copy())
-        if (opt.max_newton_iterations is not None and total_iters >= opt.max_newton_iterations
-                and t < 1.0 - 1e-14):
-            return StaticResult(
-                False, t, records, total_iters,
-                f"Newton budget of {opt.max_newton_iterations} iterations spent after {where}",
-                time.perf_counter() - start, s.state.copy())
-        if res.iterations < opt.grow_below:
-            dt = min(opt.max_step, dt * 2.0)
-    return StaticResult(True, 1.0, records, total_iters, "", time.perf_counter() - start)
 
 
 @dataclass

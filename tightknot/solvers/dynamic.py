@@ -15,7 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton_solve
+from tightknot.solvers.newton import (
+    Immediate,
+    NewtonOptions,
+    NewtonResult,
+    newton_gen,
+    newton_solve,
+    run_now,
+)
 from tightknot.solvers.system import Inertia, RodSystem
 
 
@@ -111,6 +118,30 @@ class ProximalResult:
     reason: str
 
 
+class ImmediateSystem(Immediate):
+    """A :class:`RodSystem` as the generator solvers see it (:class:`Immediate`), with what
+    the proximal steps and the load continuation ask of it besides the Newton loop."""
+
+    def __init__(self, system: RodSystem) -> None:
+        super().__init__(system)
+        self.system = system
+
+    @property
+    def handle(self) -> RodSystem:
+        """What a continuation's predictor is given: the system."""
+        return self.system
+
+    @property
+    def last_split(self):  # noqa: ANN201 (EnergySplit)
+        return self.system.last_split
+
+    def set_load(self, t: float) -> None:
+        self.system.set_load(t)
+
+    def set_inertia(self, inertia: Inertia | None) -> None:
+        self.system.inertia = inertia
+
+
 def proximal_relax(
     system: RodSystem,
     dt: float = 1e-3,
@@ -126,29 +157,36 @@ def proximal_relax(
     is not; dt grows after easy steps and shrinks after failed ones. It stops when a static
     Newton solve from the current state converges. The state's velocities stay zero.
     """
+    return run_now(proximal_gen(ImmediateSystem(system), dt, max_steps, options, grow_below))
+
+
+def proximal_gen(p, dt: float = 1e-3, max_steps: int = 200,  # noqa: ANN001
+                 options: NewtonOptions | None = None, grow_below: int = 8):
+    """:func:`proximal_relax` as a generator over a problem ``p`` of the generator solvers
+    (:class:`ImmediateSystem`, or one rod of a batch); returns the ProximalResult."""
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be finite and > 0 s, got {dt!r}")
-    m = system.model
-    if not (m.vertex_mass > 0).all():
+    s = p.system
+    if not (s.model.vertex_mass > 0).all():
         raise ValueError("proximal relaxation needs density > 0 for every rod")
     opts = options or NewtonOptions()
     iters = 0
     for k in range(1, max_steps + 1):
-        saved = system.state.copy()
-        system.inertia = Inertia(dt=dt, q_hat=system.full_dofs(), mass=system.dof_mass)
+        saved = s.state.copy()
+        p.set_inertia(Inertia(dt=dt, q_hat=s.full_dofs(), mass=s.dof_mass))
         try:
-            res = newton_solve(system, system.free_vector(), opts)
+            res = yield from newton_gen(p, s.free_vector(), opts)
         finally:
-            system.inertia = None
+            p.set_inertia(None)
         iters += res.iterations
         if not res.converged:
-            system.state = saved
+            s.state = saved
             dt *= 0.25
             continue
         if res.iterations < grow_below:
             dt *= 2.0
-        static = newton_solve(system, system.free_vector(),
-                              NewtonOptions(residual_tol=opts.residual_tol, max_iterations=15))
+        static = yield from newton_gen(
+            p, s.free_vector(), NewtonOptions(residual_tol=opts.residual_tol, max_iterations=15))
         iters += static.iterations
         if static.converged:
             return ProximalResult(True, k, iters, "converged")

@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Generator
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -127,42 +128,114 @@ def newton_solve(
     problem: NewtonProblem, u0: np.ndarray, options: NewtonOptions | None = None
 ) -> NewtonResult:
     """Minimise the problem's potential from ``u0``; accepted iterates go to the problem."""
+    return run_now(newton_gen(Immediate(problem), u0, options))
+
+
+class Immediate:
+    """A :class:`NewtonProblem` as the generator solvers see a problem: each question
+    (evaluation, step bound, acceptance) is answered at once, and the Newton systems are
+    solved by the sparse direct solver. The batch of rods (:mod:`tightknot.knots.batch_newton`)
+    answers the same questions for many rods together instead."""
+
+    def __init__(self, problem: NewtonProblem) -> None:
+        self.problem = problem
+
+    def evaluate(self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True):
+        """Generator returning ``problem.evaluate(u, ...)``."""
+        return self.problem.evaluate(u, want_grad, want_hess)
+        yield  # noqa: B901 (a generator that never yields: the answer is immediate)
+
+    def max_step(self, u: np.ndarray, du: np.ndarray):
+        """Generator returning ``problem.max_step(u, du)``."""
+        return self.problem.max_step(u, du)
+        yield  # noqa: B901
+
+    def accept(self, u: np.ndarray):
+        """Generator making ``u`` the problem's state."""
+        self.problem.accept(u)
+        return
+        yield  # noqa: B901
+
+    def residual_norm(self, g: np.ndarray) -> float:
+        return self.problem.residual_norm(g)
+
+    def step_norm(self, du: np.ndarray) -> float:
+        return self.problem.step_norm(du)
+
+    def energy_roundoff(self) -> float:
+        return self.problem.energy_roundoff()
+
+    @staticmethod
+    def matrix(h: sp.csc_matrix) -> sp.csc_matrix:
+        """The Hessian as a sparse matrix (for products)."""
+        return h
+
+    @staticmethod
+    def diagonal(h: sp.csc_matrix) -> np.ndarray:
+        return h.diagonal()
+
+    @staticmethod
+    def shifted_direction(h: sp.csc_matrix, g: np.ndarray, mu: float,
+                          diag: np.ndarray) -> np.ndarray | None:
+        """Solve (H + mu D) d = -g; None when singular or not finite."""
+        return _shifted_direction(h, g, mu, diag)
+
+
+def run_now(gen: Generator) -> Any:
+    """Run a solver generator whose questions are all answered at once (it never yields);
+    its return value."""
+    try:
+        question = next(gen)
+    except StopIteration as done:
+        return done.value
+    raise RuntimeError(f"a solver run directly asked a question it cannot answer: {question!r}")
+
+
+def newton_gen(p: Any, u0: np.ndarray, options: NewtonOptions | None = None):
+    """The damped Newton loop (module docstring) as a generator: every evaluation, step
+    bound and acceptance is a sub-generator of the problem ``p`` (``yield from``), so one
+    loop serves a problem answered at once (:class:`Immediate`, :func:`newton_solve`) and
+    rods whose questions are answered together (:mod:`tightknot.knots.batch_newton`).
+    Returns the :class:`NewtonResult`."""
     opt = options or NewtonOptions()
     u = np.array(u0, dtype=np.float64)
-    energy, g, h = problem.evaluate(u, True, True)
+    energy, g, hp = yield from p.evaluate(u, True, True)
     if not (math.isfinite(energy) and np.isfinite(g).all()):
         return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
-    res = problem.residual_norm(g)
+    res = p.residual_norm(g)
     if not math.isfinite(res):  # e.g. a zero force scale (a rod without stiffness)
         return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
     history = [res]
     mu = 0.0
     step = math.inf
     if res <= opt.residual_tol:
-        problem.accept(u)
+        yield from p.accept(u)
         return NewtonResult(True, 0, res, 0.0, energy, "converged", history)
     # Progress record of the stall test: best residual and energy after each iteration.
     best = [res]
     energies = [energy]
     for it in range(1, opt.max_iterations + 1):
         accepted = False
-        diag = np.abs(h.diagonal())
+        h = p.matrix(hp)
+        diag = np.abs(p.diagonal(hp))
         diag = np.maximum(diag, 1e-12 * (diag.max() if diag.size else 1.0))
         while not accepted:
-            d = _shifted_direction(h, g, mu, diag)
-            if d is None or not _acceptable(d, g, h, mu, diag):
+            d = p.shifted_direction(hp, g, mu, diag)
+            # H d is kept for the model decrease after the line search.
+            hd = None if d is None else h @ d
+            if d is None or not _acceptable(d, g, hd, mu, diag):
                 mu = opt.shift_initial if mu == 0.0 else mu * 10.0
                 if mu > opt.shift_max:
-                    problem.accept(u)
+                    yield from p.accept(u)
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
                                         history)
                 continue
-            alpha = min(1.0, problem.max_step(u, d))
+            alpha = min(1.0, (yield from p.max_step(u, d)))
             slope = float(g @ d)
-            roundoff = problem.energy_roundoff()
+            roundoff = p.energy_roundoff()
             for _ in range(opt.max_backtracks):
                 trial = u + alpha * d
-                e_trial, _, _ = problem.evaluate(trial, False, False)
+                e_trial, _, _ = yield from p.evaluate(trial, False, False)
                 if not math.isfinite(e_trial):
                     alpha *= 0.5
                     continue
@@ -179,19 +252,19 @@ def newton_solve(
             if not accepted:
                 mu = opt.shift_initial if mu == 0.0 else mu * 10.0
                 if mu > opt.shift_max:
-                    problem.accept(u)
+                    yield from p.accept(u)
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
                                         history)
         du = alpha * d
-        predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ (h @ d)))
+        predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ hd))
         u = u + du
-        step = problem.step_norm(du)
-        problem.accept(u)
+        step = p.step_norm(du)
+        yield from p.accept(u)
         e_old = energy
-        energy, g, h = problem.evaluate(u, True, True)
+        energy, g, hp = yield from p.evaluate(u, True, True)
         if not (math.isfinite(energy) and np.isfinite(g).all()):
             return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
-        res = problem.residual_norm(g)
+        res = p.residual_norm(g)
         if not math.isfinite(res):
             return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
         history.append(res)
@@ -212,7 +285,7 @@ def newton_solve(
             return NewtonResult(False, it, res, step, energy, "stagnated", history)
         best.append(min(best[-1], res))
         energies.append(energy)
-        if _stalled(best, energies, opt, problem.energy_roundoff()):
+        if _stalled(best, energies, opt, p.energy_roundoff()):
             return NewtonResult(False, it, res, step, energy, "stalled", history)
     return NewtonResult(False, opt.max_iterations, res, step, energy, "max_iterations", history)
 
@@ -239,12 +312,12 @@ def _shifted_direction(
     return d if np.isfinite(d).all() else None
 
 
-def _acceptable(d: np.ndarray, g: np.ndarray, h: sp.csc_matrix, mu: float,
+def _acceptable(d: np.ndarray, g: np.ndarray, hd: np.ndarray, mu: float,
                 diag: np.ndarray) -> bool:
     # A descent direction along which the shifted model (the one the step minimises) has
     # positive curvature; otherwise that model is not positive definite there and the shift
     # must grow. The unshifted Hessian may stay indefinite (a loose knot is floppy): with
     # the shift the step is a damped descent step, and the line search judges it.
     slope = float(g @ d)
-    curv = float(d @ (h @ d)) + mu * float(np.sum(diag * d * d))
+    curv = float(d @ hd) + mu * float(np.sum(diag * d * d))
     return slope < 0.0 and curv > 0.0

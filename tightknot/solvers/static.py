@@ -18,9 +18,11 @@ import numbers
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from tightknot.rods.state import State
-from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton_solve
+from tightknot.solvers.dynamic import ImmediateSystem, proximal_gen
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton_gen, run_now
 from tightknot.solvers.system import RodSystem
 
 
@@ -124,15 +126,27 @@ def solve_static(
     the run as failed with that reason (e.g. a topology check that found the knot changed).
     ``predictor(system, t, t_next)`` may move the state before each step's Newton solve.
     """
+    return run_now(continuation_gen(ImmediateSystem(system), options, callback, predictor,
+                                    t_start))
+
+
+def continuation_gen(p, options: ContinuationOptions | None = None,  # noqa: ANN001
+                     callback: StepCallback | None = None,
+                     predictor: Callable[[Any, float, float], None] | None = None,
+                     t_start: float = 0.0):
+    """:func:`solve_static` as a generator over a problem ``p`` of the generator solvers
+    (:class:`tightknot.solvers.dynamic.ImmediateSystem`, or one rod of a batch): the
+    callback gets ``p.system``, the predictor ``p.handle``; returns the StaticResult."""
     opt = options or ContinuationOptions()
+    system = p.system
     start = time.perf_counter()
     t = float(t_start)
     dt = min(opt.max_step, (1.0 - t) / opt.steps) if t < 1.0 else 0.0
     records: list[StepRecord] = []
     total_iters = 0
     if t >= 1.0 or dt == 0.0:
-        system.set_load(1.0)
-        res = newton_solve(system, system.free_vector(), opt.newton)
+        p.set_load(1.0)
+        res = yield from newton_gen(p, system.free_vector(), opt.newton)
         rec = StepRecord(1.0, res)
         total_iters += res.iterations
         if res.converged:
@@ -145,28 +159,26 @@ def solve_static(
     while t < 1.0 - 1e-14:
         t_next = min(1.0, t + dt)
         saved = system.state.copy()
-        system.set_load(t_next)
+        p.set_load(t_next)
         if predictor is not None:
-            predictor(system, t, t_next)
-        res = newton_solve(system, system.free_vector(), opt.newton)
+            predictor(p.handle, t, t_next)
+        res = yield from newton_gen(p, system.free_vector(), opt.newton)
         total_iters += res.iterations
         if not res.converged and opt.proximal_dt is not None:
             # The static path may have a limit point here: descend through it by proximal
             # (fully damped implicit) steps from the last iterate at this load.
-            from tightknot.solvers.dynamic import proximal_relax
-
-            prox = proximal_relax(system, opt.proximal_dt, opt.proximal_steps, opt.newton)
+            prox = yield from proximal_gen(p, opt.proximal_dt, opt.proximal_steps, opt.newton)
             total_iters += prox.newton_iterations
             if prox.converged:
-                _, g, _ = system.evaluate(system.free_vector(), True, False)
+                _, g, _ = yield from p.evaluate(system.free_vector(), True, False)
                 res = NewtonResult(True, res.iterations + prox.newton_iterations,
-                                   system.residual_norm(g), 0.0, system.last_split.total,
+                                   system.residual_norm(g), 0.0, p.last_split.total,
                                    "converged_by_proximal_steps", res.history)
         where = f"load step {len(records) + 1} (from t={t:.6g} to t={t_next:.6g})"
         if not res.converged:
             failed = system.state.copy()
             system.state = saved
-            system.set_load(t)
+            p.set_load(t)
             dt *= 0.5
             why = None
             if dt < opt.min_step:
