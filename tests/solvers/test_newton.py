@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pytest
 
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
@@ -80,3 +81,52 @@ def test_pattern_drops_fixed_dofs() -> None:
     assert pat.n == int((~fixed).sum())
     # Every stored entry is on free dofs, and the diagonal is present for each free dof.
     assert (pat.diag_slot >= 0).all()
+
+
+class _Deferred:
+    """A problem of the generator solvers whose evaluations are questions (yielded) that
+    the test answers, as the batch of rods does."""
+
+    def __init__(self, system: RodSystem) -> None:
+        from tightknot.solvers.dynamic import ImmediateSystem
+
+        self._now = ImmediateSystem(system)
+        self.asked = 0
+
+    def __getattr__(self, name: str):  # noqa: ANN204 (everything else: answered at once)
+        return getattr(self._now, name)
+
+    def evaluate(self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True):
+        self.asked += 1
+        answer = yield ("evaluate", u, want_grad, want_hess)
+        return answer
+
+
+def test_a_question_answered_later_gives_the_same_solve() -> None:
+    from tightknot.solvers.static import continuation_gen
+
+    direct = _cantilever(load_parameter=1.0)
+    ref = solve_static(direct, ContinuationOptions(steps=4))
+    system = _cantilever(load_parameter=1.0)
+    p = _Deferred(system)
+    gen = continuation_gen(p, ContinuationOptions(steps=4))
+    question = next(gen)
+    while True:
+        _, u, wg, wh = question
+        try:
+            question = gen.send(system.evaluate(u, wg, wh))
+        except StopIteration as done:
+            res = done.value
+            break
+    assert p.asked > 0
+    assert res.converged and res.newton_iterations == ref.newton_iterations
+    np.testing.assert_array_equal(system.state.x, direct.state.x)
+
+
+def test_run_now_refuses_a_question() -> None:
+    from tightknot.solvers.newton import newton_gen, run_now
+
+    system = _cantilever()
+    system.set_load(1.0)
+    with pytest.raises(RuntimeError, match="cannot answer"):
+        run_now(newton_gen(_Deferred(system), system.free_vector()))
