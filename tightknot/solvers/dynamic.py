@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from tightknot.solvers.newton import (
     newton_solve,
     run_now,
 )
-from tightknot.solvers.system import Inertia, RodSystem
+from tightknot.solvers.system import EnergySplit, Inertia, RodSystem
 
 
 @dataclass
@@ -124,7 +125,10 @@ class ImmediateSystem(Immediate):
 
     def __init__(self, system: RodSystem) -> None:
         super().__init__(system)
-        self.system = system
+
+    @property
+    def system(self) -> RodSystem:
+        return self.problem
 
     @property
     def handle(self) -> RodSystem:
@@ -132,7 +136,7 @@ class ImmediateSystem(Immediate):
         return self.system
 
     @property
-    def last_split(self):  # noqa: ANN201 (EnergySplit)
+    def last_split(self) -> EnergySplit:
         return self.system.last_split
 
     def set_load(self, t: float) -> None:
@@ -160,7 +164,7 @@ def proximal_relax(
     return run_now(proximal_gen(ImmediateSystem(system), dt, max_steps, options, grow_below))
 
 
-def proximal_gen(p, dt: float = 1e-3, max_steps: int = 200,  # noqa: ANN001
+def proximal_gen(p: Any, dt: float = 1e-3, max_steps: int = 200,
                  options: NewtonOptions | None = None, grow_below: int = 8):
     """:func:`proximal_relax` as a generator over a problem ``p`` of the generator solvers
     (:class:`ImmediateSystem`, or one rod of a batch); returns the ProximalResult."""

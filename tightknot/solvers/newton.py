@@ -143,18 +143,18 @@ class Immediate:
     def evaluate(self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True):
         """Generator returning ``problem.evaluate(u, ...)``."""
         return self.problem.evaluate(u, want_grad, want_hess)
-        yield  # noqa: B901 (a generator that never yields: the answer is immediate)
+        yield  # unreachable: makes this a generator whose answer is immediate
 
     def max_step(self, u: np.ndarray, du: np.ndarray):
         """Generator returning ``problem.max_step(u, du)``."""
         return self.problem.max_step(u, du)
-        yield  # noqa: B901
+        yield  # unreachable (as above)
 
     def accept(self, u: np.ndarray):
         """Generator making ``u`` the problem's state."""
         self.problem.accept(u)
         return
-        yield  # noqa: B901
+        yield  # unreachable (as above)
 
     def residual_norm(self, g: np.ndarray) -> float:
         return self.problem.residual_norm(g)

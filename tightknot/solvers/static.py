@@ -130,7 +130,7 @@ def solve_static(
                                     t_start))
 
 
-def continuation_gen(p, options: ContinuationOptions | None = None,  # noqa: ANN001
+def continuation_gen(p: Any, options: ContinuationOptions | None = None,
                      callback: StepCallback | None = None,
                      predictor: Callable[[Any, float, float], None] | None = None,
                      t_start: float = 0.0):
