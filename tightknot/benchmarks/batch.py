@@ -80,10 +80,12 @@ def shape_difference(x: np.ndarray, y: np.ndarray, diameter: float) -> float:
 
 
 def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.0, 20.0),
-        sequential_rods: int | None = None, residual_tol: float = 1e-6) -> dict:
+        sequential_rods: int | None = None, residual_tol: float = 1e-6,
+        device: str = "cpu") -> dict:
     """Tie ``rods`` closed trefoils of ``nodes`` vertices (L0/D0 evenly over the range)
     batched and one by one; ``sequential_rods`` < rods ties only that many evenly chosen
-    cases one by one and extrapolates the sequential time (said so in the result)."""
+    cases one by one and extrapolates the sequential time (said so in the result). Both
+    run on the Warp ``device`` (the linear algebra stays on the CPU)."""
     if int(rods) != rods or rods < 1:
         raise ValueError(f"rods must be a whole number >= 1, got {rods!r}")
     seq_n = rods if sequential_rods is None else int(sequential_rods)
@@ -93,11 +95,12 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
     if not (math.isfinite(lo) and math.isfinite(hi) and 10.0 <= lo <= hi):
         raise ValueError(f"l0_over_d0 must be a range LO <= HI with LO >= 10, got {l0_over_d0}")
     ratios = np.linspace(lo, hi, rods)
-    scenes = [closed_trefoil(l0_over_d0=float(r), nodes=nodes) for r in ratios]
+    scenes = [closed_trefoil(l0_over_d0=float(r), nodes=nodes, device=device)
+              for r in ratios]
     # Warm up both paths on one small case (kernel modules loaded, tables cached), so that
     # neither pays a one-time cost inside its timing.
-    tie(closed_trefoil(l0_over_d0=lo, nodes=nodes))
-    tie_batch([closed_trefoil(l0_over_d0=lo, nodes=nodes)])
+    tie(closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device))
+    tie_batch([closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device)])
     t0 = time.perf_counter()
     batch = tie_batch(scenes, residual_tol=residual_tol)
     tb = time.perf_counter() - t0
@@ -114,7 +117,7 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
     # ties run under the same setting, so that the ratio measures the batching alone.
     with single_blas_thread():
         for k in pick:
-            scene = closed_trefoil(l0_over_d0=float(ratios[k]), nodes=nodes)
+            scene = closed_trefoil(l0_over_d0=float(ratios[k]), nodes=nodes, device=device)
             t0 = time.perf_counter()
             single = tie(scene, residual_tol=residual_tol)
             ts += time.perf_counter() - t0
@@ -137,6 +140,7 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
     return {
         "rods": rods,
         "vertices": nodes,
+        "device": device,
         "l0_over_d0": [lo, hi],
         "cases": "sweep: L0/D0 evenly over the range, one case per rod",
         "batched_s": tb,
@@ -197,6 +201,7 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
     p.add_argument("--nodes", type=int, default=100, help="vertices per knot (default 100)")
     p.add_argument("--l0-over-d0", type=float, nargs=2, default=(17.0, 20.0),
                    metavar=("LO", "HI"), help="range of L0/D0 (default 17 20)")
+    p.add_argument("--device", default=None, help="Warp device (default cpu)")
     p.add_argument("--sequential-rods", type=int, default=None,
                    help="tie only this many one by one and extrapolate (default: all)")
     p.set_defaults(handler=_command)
@@ -209,7 +214,10 @@ def _command(args) -> int:  # noqa: ANN001
     out = _writable_file(args.json)
     if args.nodes < 24:
         raise ValueError(f"--nodes must be >= 24, got {args.nodes}")
-    r = run(args.rods, args.nodes, tuple(args.l0_over_d0), args.sequential_rods)
+    from tightknot.warp_setup import resolve_device
+
+    r = run(args.rods, args.nodes, tuple(args.l0_over_d0), args.sequential_rods,
+            device=resolve_device(args.device))
     note = " (extrapolated)" if r["sequential_extrapolated"] else ""
     print(f"{r['rods']} closed trefoils of {r['vertices']} vertices: batched "
           f"{r['batched_s']:.2f} s ({r['batched_newton_iterations']} iterations), sequential "
