@@ -55,14 +55,12 @@ from tightknot.knots.batch_newton import (
     run_lockstep,
 )
 from tightknot.knots.scenes import KnotScene, gauge
-from tightknot.knots.tie import _opts as tie_continuation_options
-from tightknot.knots.tie import knot_type_of
+from tightknot.knots.tie import knot_type_of, tie_gen
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.contact import ContactLayer
 from tightknot.rods.model import Model
 from tightknot.solvers.linear import SparsePattern
-from tightknot.solvers.newton import NewtonOptions, newton_gen
-from tightknot.solvers.static import StaticResult, StepRecord, continuation_gen
+from tightknot.solvers.static import StaticResult
 from tightknot.solvers.system import RodSystem
 
 #: Gap between the bounding boxes of two copies, in rest diameters: far beyond the
@@ -194,69 +192,29 @@ def build_batch(scenes: list[KnotScene]) -> BatchModel:
 
 def _tie_program(k: int, scene: KnotScene, evaluator: BatchEvaluator, tighten_steps: int,
                  residual_tol: float, relax_iterations: int):
-    """The closed-knot path of :func:`tightknot.knots.tie.tie` for rod ``k`` (generator)."""
-    types: list[str] = []
-    phases: dict[str, StaticResult] = {}
-    iters = 0
+    """:func:`tightknot.knots.tie.tie` of the closed knot ``scene`` as rod ``k`` of the batch
+    (generator): tie's own program (:func:`tightknot.knots.tie.tie_gen`), whose systems are
+    answered by the batch's evaluator, from a copy of the scene's state."""
     check_s = [0.0]
-    model = scene.model
+    stats = LinearStats()
 
-    def done(ok: bool, msg: str, p: RodProblem) -> RodOutcome:
-        system = p.system
-        system.add_term(scene.contact)
-        return RodOutcome(ok, msg, iters, types, phases, p.stats, check_s[0], system)
+    def problem(system: RodSystem) -> RodProblem:
+        p = RodProblem(k, system, evaluator)
+        p.stats = stats  # one record of the rod's factorizations over its phases
+        return p
 
-    shrink = 1.0 / scene.start_length_ratio
-    system = RodSystem(model, scene.state.copy(), gauge(scene))
-    scene.contact.check_no_intersection(system.state.x)
-    p = RodProblem(k, system, evaluator)
-    p.set_load(0.0)
-    relax = yield from newton_gen(p, system.free_vector(),
-                                  NewtonOptions(residual_tol=residual_tol,
-                                                max_iterations=relax_iterations))
-    iters += relax.iterations
-    if not relax.converged:
-        return done(False, f"relax: Newton {relax.reason} (residual {relax.residual:.3g}) at "
-                    "the start", p)
-    t0 = time.perf_counter()
-    kt = knot_type_of(scene, system.state.x)
-    check_s[0] += time.perf_counter() - t0
-    types.append(kt)
-    if kt != scene.knot_type:
-        return done(False, f"relax: knot type {kt}, expected {scene.knot_type}", p)
-    bcs = gauge(scene, positions=system.state.x)
-    bcs.rest_length_scale((1.0, shrink))
-    system = RodSystem(model, system.state, bcs)
-    scene.contact.check_no_intersection(system.state.x)
-    stats = p.stats
-    p = RodProblem(k, system, evaluator)
-    p.stats = stats
-    p.set_load(0.0)
-
-    def similar(prob: RodProblem, t0: float, t1: float) -> None:
-        # tie()'s self-similar predictor: the previous equilibrium scaled about the pinned
-        # first vertex (the origin of the scene's frame) keeps every strain.
-        c = (1.0 + (shrink - 1.0) * t1) / (1.0 + (shrink - 1.0) * t0)
-        prob.system.state.x = prob.system.state.x * c
-        prob.set_load(t1)
-
-    def check(sys_: RodSystem, rec: StepRecord) -> str | None:
+    def timed_knot_type(sc: KnotScene, x: np.ndarray) -> str:
         t0 = time.perf_counter()
-        kt = knot_type_of(scene, sys_.state.x)
-        check_s[0] += time.perf_counter() - t0
-        types.append(kt)
-        if kt != scene.knot_type:
-            return (f"topology changed in phase tighten at load t={rec.t:.4g}: knot type "
-                    f"{kt}, expected {scene.knot_type} (the rod passed through itself)")
-        return None
+        try:
+            return knot_type_of(sc, x)
+        finally:
+            check_s[0] += time.perf_counter() - t0
 
-    res = yield from continuation_gen(p, tie_continuation_options(tighten_steps, residual_tol),
-                                      check, similar)
-    phases["tighten"] = res
-    iters += res.newton_iterations
-    if not res.converged:
-        return done(False, f"tighten: {res.failure}", p)
-    return done(True, "", p)
+    res = yield from tie_gen(scene, tighten_steps=tighten_steps, residual_tol=residual_tol,
+                             relax_iterations=relax_iterations, problem=problem,
+                             start_state=scene.state.copy(), knot_type=timed_knot_type)
+    return RodOutcome(res.converged, res.failure, res.newton_iterations, res.knot_types,
+                      res.phases, stats, check_s[0], res.system)
 
 
 def tie_batch(

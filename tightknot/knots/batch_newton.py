@@ -32,6 +32,7 @@ from tightknot.knots.batch_eval import (
     StepRequest,
 )
 from tightknot.knots.batch_linear import BandedCholesky, BandPlan, banded_lu_solve
+from tightknot.rods.state import State
 from tightknot.solvers.linear import factorize
 from tightknot.solvers.system import EnergySplit, Inertia, RodSystem
 
@@ -91,6 +92,11 @@ class RodProblem:
         self._certificate: tuple[HessianData, float, float] | None = None
 
     # -- load path ---------------------------------------------------------------------
+    @property
+    def state(self) -> State:
+        """The rod's state (what tie()'s predictor moves)."""
+        return self.system.state
+
     def set_load(self, t: float) -> None:
         """As RodSystem.set_load, and tell the evaluator the rod's new rest lengths."""
         self.system.set_load(t)

@@ -24,6 +24,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -37,8 +38,14 @@ from tightknot.knots.scenes import (
 )
 from tightknot.rods.contact import SelfIntersectionError
 from tightknot.rods.state import State
-from tightknot.solvers.newton import NewtonOptions, newton_solve
-from tightknot.solvers.static import ContinuationOptions, StaticResult, StepRecord, solve_static
+from tightknot.solvers.dynamic import ImmediateSystem
+from tightknot.solvers.newton import NewtonOptions, newton_gen, newton_solve, run_now
+from tightknot.solvers.static import (
+    ContinuationOptions,
+    StaticResult,
+    StepRecord,
+    continuation_gen,
+)
 from tightknot.solvers.system import RodSystem
 
 StepHook = Callable[[str, RodSystem, StepRecord], None]
@@ -83,9 +90,10 @@ def knot_type_of(scene: KnotScene, x: np.ndarray) -> str:
         return "undefined (the curve nearly passes through itself)"
 
 
-def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | None):
+def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | None,
+             knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of):
     def check(system: RodSystem, rec: StepRecord) -> str | None:
-        kt = knot_type_of(scene, system.state.x)
+        kt = knot_type(scene, system.state.x)
         types.append(kt)
         if hook is not None:
             hook(phase, system, rec)
@@ -132,6 +140,29 @@ def tie(
         relax_iterations: Newton budget of the relaxation of the start curve.
         hook: called after each converged step with (phase, system, record).
     """
+    return run_now(tie_gen(scene, pull_force, end_distance, tighten_steps, pull_steps,
+                           residual_tol, hold_force_scale, relax_iterations, hook))
+
+
+def tie_gen(
+    scene: KnotScene,
+    pull_force: float | None = None,
+    end_distance: float | None = None,
+    tighten_steps: int = 20,
+    pull_steps: int = 20,
+    residual_tol: float = 1e-6,
+    hold_force_scale: float = 0.05,
+    relax_iterations: int = 2000,
+    hook: StepHook | None = None,
+    problem: Callable[[RodSystem], Any] = ImmediateSystem,
+    start_state: State | None = None,
+    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
+):
+    """:func:`tie` as a generator of the solvers' questions (:mod:`tightknot.solvers.newton`):
+    every phase's system is handed to the solvers as ``problem(system)`` (default: answered
+    at once; a batch of rods answers many rods' questions together,
+    :mod:`tightknot.knots.batch`), starting from ``start_state`` (default: the scene's), with the
+    knot type computed by ``knot_type``. Returns the :class:`TieResult`."""
     if scene.contact is None:
         raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
                          "the rod passes through itself); use 'compliant' or 'rigid'")
@@ -166,16 +197,17 @@ def tie(
     bcs = gauge(scene)
     if not scene.closed:
         bcs.force(0, last, lambda t: hold * axis)
-    system = RodSystem(model, scene.state, bcs)
+    system = RodSystem(model, scene.state if start_state is None else start_state, bcs)
     system.add_term(scene.contact)
-    system.set_load(0.0)
-    relax = newton_solve(system, system.free_vector(),
-                         NewtonOptions(residual_tol=residual_tol, max_iterations=relax_iterations))
+    p = problem(system)
+    p.set_load(0.0)
+    relax = yield from newton_gen(p, system.free_vector(), NewtonOptions(
+        residual_tol=residual_tol, max_iterations=relax_iterations))
     iters += relax.iterations
     if not relax.converged:
         return fail(f"relax: Newton {relax.reason} (residual {relax.residual:.3g}) at the start",
                     system, hold)
-    kt = knot_type_of(scene, system.state.x)
+    kt = knot_type(scene, system.state.x)
     types.append(kt)
     if kt != scene.knot_type:
         return fail(f"relax: knot type {kt}, expected {scene.knot_type}", system, hold)
@@ -192,17 +224,21 @@ def tie(
     bcs.rest_length_scale((1.0, shrink))
     system = RodSystem(model, system.state, bcs)
     system.add_term(scene.contact)
-    system.set_load(0.0)
+    p = problem(system)
+    p.set_load(0.0)
+
     def similar(sys_: RodSystem, t0: float, t1: float) -> None:
         # Self-similar predictor: the previous equilibrium scaled about the pinned first
         # vertex (the origin) by the change of rest length keeps every strain; prescribed
-        # ends and the gauge's zero coordinates are unchanged by it.
+        # ends and the gauge's zero coordinates are unchanged by it. (``sys_``: the
+        # system, or a batch's rod: what has ``state`` and ``set_load``.)
         c = (1.0 + (shrink - 1.0) * t1) / (1.0 + (shrink - 1.0) * t0)
         sys_.state.x = sys_.state.x * c
         sys_.set_load(t1)
 
-    res = solve_static(system, _opts(tighten_steps, residual_tol),
-                       callback=_checker(scene, "tighten", types, hook), predictor=similar)
+    res = yield from continuation_gen(p, _opts(tighten_steps, residual_tol),
+                                      _checker(scene, "tighten", types, hook, knot_type),
+                                      similar)
     phases["tighten"] = res
     iters += res.newton_iterations
     if not res.converged:
@@ -238,9 +274,10 @@ def tie(
         final_force = math.nan
     system = RodSystem(model, state, bcs)
     system.add_term(scene.contact)
-    system.set_load(0.0)
-    res = solve_static(system, _opts(pull_steps, residual_tol),
-                       callback=_checker(scene, "pull", types, hook))
+    p = problem(system)
+    p.set_load(0.0)
+    res = yield from continuation_gen(p, _opts(pull_steps, residual_tol),
+                                      _checker(scene, "pull", types, hook, knot_type))
     phases["pull"] = res
     iters += res.newton_iterations
     if end_distance is not None:
