@@ -17,6 +17,7 @@ and of the linear solve (banded Cholesky where the matrix is positive definite, 
 otherwise, :mod:`tightknot.knots.batch_linear`, where the one-rod solver uses SuperLU;
 ``tests/knots/test_batch.py`` compares each rod with its own tie).
 """
+
 from __future__ import annotations
 
 import time

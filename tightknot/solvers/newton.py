@@ -49,6 +49,35 @@ class NewtonProblem(Protocol):
     def energy_roundoff(self) -> float: ...
 
 
+class GeneratorProblem(Protocol):
+    """What the generator solvers (:func:`newton_gen`, and ``proximal_gen``,
+    ``continuation_gen``) need of a problem. ``evaluate``, ``max_step`` and ``accept`` are
+    generators (their answer may come from outside: a batch answers many rods together);
+    the rest is answered at once. ``proximal_gen`` and ``continuation_gen`` also use
+    ``system`` (the RodSystem), ``handle`` (what a predictor is given), ``last_split``,
+    ``set_load(t)`` and ``set_inertia(inertia)``."""
+
+    def evaluate(self, u: np.ndarray, want_grad: bool = True,
+                 want_hess: bool = True) -> Generator: ...
+
+    def max_step(self, u: np.ndarray, du: np.ndarray) -> Generator: ...
+
+    def accept(self, u: np.ndarray) -> Generator: ...
+
+    def residual_norm(self, g: np.ndarray) -> float: ...
+
+    def step_norm(self, du: np.ndarray) -> float: ...
+
+    def energy_roundoff(self) -> float: ...
+
+    def matrix(self, h: Any) -> sp.spmatrix: ...
+
+    def diagonal(self, h: Any) -> np.ndarray: ...
+
+    def shifted_direction(self, h: Any, g: np.ndarray, mu: float,
+                          diag: np.ndarray) -> np.ndarray | None: ...
+
+
 @dataclass
 class NewtonOptions:
     """Settings of the Newton loop.
@@ -132,7 +161,7 @@ def newton_solve(
 
 
 class Immediate:
-    """A :class:`NewtonProblem` as the generator solvers see a problem: each question
+    """A :class:`NewtonProblem` as a :class:`GeneratorProblem`: each question
     (evaluation, step bound, acceptance) is answered at once, and the Newton systems are
     solved by the sparse direct solver. The batch of rods (:mod:`tightknot.knots.batch_newton`)
     answers the same questions for many rods together instead."""
@@ -191,7 +220,7 @@ def run_now(gen: Generator) -> Any:
     raise RuntimeError(f"a solver run directly asked a question it cannot answer: {question!r}")
 
 
-def newton_gen(p: Any, u0: np.ndarray, options: NewtonOptions | None = None):
+def newton_gen(p: GeneratorProblem, u0: np.ndarray, options: NewtonOptions | None = None):
     """The damped Newton loop (module docstring) as a generator: every evaluation, step
     bound and acceptance is a sub-generator of the problem ``p`` (``yield from``), so one
     loop serves a problem answered at once (:class:`Immediate`, :func:`newton_solve`) and
