@@ -102,3 +102,50 @@ def test_process_pool_and_dask_give_the_serial_records(tmp_path: Path,
     import os
 
     assert {r["pid"] for r in by_pool.records()} != {os.getpid()}
+
+
+def _close(a, b, path: str = "") -> None:
+    """Records equal but for round-off: the batched rods follow their own tie's path with
+    sums in another order and banded instead of sparse LU solves (tests/knots/test_batch.py:
+    positions within 1e-10 D0), so measured floats agree to 1e-8 relative (absolute 1e-9
+    for values near zero), and everything else exactly."""
+    if isinstance(a, dict):
+        assert sorted(a) == sorted(b), path
+        for k in a:
+            _close(a[k], b[k], f"{path}.{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            _close(x, y, f"{path}[{k}]")
+    elif isinstance(a, float) and isinstance(b, float):
+        assert b == pytest.approx(a, rel=1e-8, abs=1e-9), path
+    else:
+        assert a == b, path
+
+
+def test_a_batched_sweep_gives_the_one_by_one_records_and_resumes(
+        tmp_path: Path, reference: dict[str, dict]) -> None:
+    folder = tmp_path / "b"
+    first = run_sweep(CASES[:2], folder, SerialExecutor(), batch=8)
+    assert first.ok and sorted(first.ran) == sorted(c.id for c in CASES[:2])
+    # Resumed with the third case added: only that one runs (a batch of one).
+    again = run_sweep(CASES, folder, SerialExecutor(), batch=8)
+    assert again.ran == [CASES[2].id] and sorted(again.skipped) == sorted(first.ran)
+    batches = {r["id"]: r["batch"] for r in again.records()}
+    assert [batches[c.id]["rods"] for c in CASES] == [2, 2, 1]
+    for rec in again.records():
+        ref = reference[rec["id"]]
+        # The same number of Newton iterations and load steps: each rod is its own tie.
+        assert rec["result"]["newton_iterations"] == ref["result"]["newton_iterations"]
+        assert rec["result"]["load_steps"] == ref["result"]["load_steps"]
+        _close(physics(ref), physics(rec))
+
+
+def test_a_batch_of_mixed_settings_is_refused_per_case() -> None:
+    from tightknot.sweep.execute import run_batch
+
+    mixed = grid({"knot": "closed", "nodes": 36, "tighten_steps": 10}, contact=["compliant",
+                                                                              "rigid"])
+    records = run_batch([c.params for c in mixed])
+    assert [r["status"] for r in records] == ["error", "error"]
+    assert "share" in records[0]["failure"] and "contact" in records[0]["failure"]

@@ -204,19 +204,26 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
         res = tie_to_lambda(scene, target, hook=hook, **tie_options)
     else:
         res = tie(scene, hook=hook, **tie_options)
-    load_steps = calls[0]
     x = res.system.state.x
     if log is not None and not np.array_equal(logged.get("x"), x):
         log.set_step(counter[0])
         counter[0] += 1
         log_state(log, scene, name, res.system, color_by)
+    return measure_run(scene, res, calls[0])
+
+
+def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
+    """The study's measurements of a tied knot (``res``, its final system's state) and its
+    JSON summary, with ``load_steps`` converged load steps (as :func:`run_knot` counts
+    them)."""
+    x = res.system.state.x
     _, r_v = vertex_radii(scene, x, res.system.rest)
     # Contact as physics.md sec. 2 defines it for a rod model: distance at most the sum of
     # the deformed radii; the measurement's 1 % tolerance covers the vertex sampling of the
     # centerline (segments touch between vertices) and the contact law's onset band.
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
                              radii=r_v, contact_tol=CONTACT_TOL)
-    contact = contact_report(scene.contact, x)
+    contact = contact_report(scene.contact, x, res.system.rest)
     summary = summarise(scene, res, rep, contact)
     summary["load_steps"] = load_steps
     return KnotRun(scene, res, rep, contact, summary)

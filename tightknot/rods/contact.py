@@ -510,8 +510,10 @@ def _segment_closest(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
     return s, t
 
 
-def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
-    """Per-vertex contact outputs of the state ``x`` [m], derived from the law's fits.
+def contact_report(layer: ContactLayer, x: np.ndarray,
+                   rest: np.ndarray | None = None) -> ContactReport:
+    """Per-vertex contact outputs of the state ``x`` [m] with edge rest lengths ``rest``
+    [m] (default: those of the layer's last evaluation), derived from the law's fits.
 
     For every non-local edge pair in contact, the closest points of the two segments give
     the distance d, the pair overlap delta = R - d (R = r_a + r_b, stretched radii) and the
@@ -528,7 +530,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray) -> ContactReport:
     m = layer.model
     law = layer.law
     n = m.vertex_count
-    rest = layer.rest
+    rest = layer.rest if rest is None else np.asarray(rest, dtype=np.float64)
     ev = m.edge_vertex
     e = x[ev[:, 1]] - x[ev[:, 0]]
     le = np.linalg.norm(e, axis=1)

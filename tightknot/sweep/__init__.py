@@ -4,7 +4,10 @@
   :func:`grid` makes the Cartesian product of parameter lists.
 * :mod:`~tightknot.sweep.path`: an open knot's tightness levels reached one after the other
   along one continuation path (tie once, then pull level by level).
-* :mod:`~tightknot.sweep.execute`: one case -> its JSON record (what the workers run).
+* :mod:`~tightknot.sweep.execute`: one case -> its JSON record (what the workers run);
+  closed-knot cases can also be tied together in one model (``run_sweep(...,
+  batch=N)``, ``tightknot sweep closed ... --batch N``): the same records, each batch
+  one task of the executor.
 * :mod:`~tightknot.sweep.store`: one atomically written JSON file per case, plus an index.
 * :mod:`~tightknot.sweep.executors`: serial, local processes (spawned), Dask distributed.
 * :mod:`~tightknot.sweep.sweep`: :func:`run_sweep`, which skips what a store has finished.

@@ -27,6 +27,9 @@ _EXAMPLES = """examples:
   # the same on a Dask cluster (pip install tightknot[distributed])
   tightknot sweep closed --l0-over-d0 16.37 18 20 --out runs/c --executor dask \\
       --scheduler tcp://scheduler:8786
+  # eight closed trefoils tied together in one model, in this process
+  tightknot sweep closed --l0-over-d0 17 17.5 18 18.5 19 19.5 20 20.5 --nodes 100 \
+      --batch 8 --executor serial --out runs/cb
   # interrupted? run the same command again: finished cases are skipped
   tightknot sweep closed --l0-over-d0 16.37 18 20 --out runs/c --json runs/c.json
 
@@ -93,6 +96,10 @@ def register(subparsers: Any) -> None:
                    help="worker processes (default: the CPU count, at most the cases)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="dask: address of a running scheduler (tcp://host:8786)")
+    p.add_argument("--batch", type=int, default=None, metavar="N",
+                   help="closed knots: tie up to N cases together in one model (one set of "
+                   "Warp launches per round for all of them; each batch one task of the "
+                   "executor)")
     p.add_argument("--retry-failed", action="store_true",
                    help="run again the cases stored as failed")
     p.add_argument("--json", metavar="FILE", help="write a summary of every case as JSON")
@@ -176,6 +183,12 @@ def run_command(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.scheduler is not None and args.executor != "dask":
         raise ValueError("--scheduler is for --executor dask")
+    if args.batch is not None:
+        if args.batch < 1:
+            raise ValueError(f"--batch must be >= 1, got {args.batch}")
+        if args.knot != "closed":
+            raise ValueError("--batch is for closed knots (open knots follow one "
+                             "continuation path per case)")
     cases = build_cases(args)
     labels = {c.id: c.label() for c in cases}
     device = resolve_device(args.device)
@@ -200,7 +213,7 @@ def run_command(args: argparse.Namespace) -> int:
             print(f"sweep of {len(cases)} case(s) into {store.folder} ({args.executor})",
                   flush=True)
         report = run_sweep(cases, store, executor, retry_failed=args.retry_failed,
-                           on_record=progress, device=device)
+                           on_record=progress, device=device, batch=args.batch)
     except BaseException:
         # Interrupted (Ctrl-C) or broken: the finished cases are stored; do not wait for
         # the running ones (they are run again by the next call).

@@ -22,8 +22,22 @@ from tightknot.sweep.store import ERROR, FAILED, OK
 if TYPE_CHECKING:
     from tightknot.knots.scenes import KnotScene
 
-#: Keys of a record that depend on the machine and the moment, not on the physics.
-TIMING_KEYS = ("wall_time_s", "cumulative_wall_time_s", "tie_wall_time_s", "host", "pid")
+#: Keys of a record that depend on the machine, the moment and how the case was run (alone
+#: or in a batch), not on the physics.
+TIMING_KEYS = ("wall_time_s", "cumulative_wall_time_s", "tie_wall_time_s", "host", "pid",
+               "batch")
+#: Parameters that every case of one batch shares (tie_batch ties them in one call, with
+#: one twist setting, one contact law, one load path); the rest (L0/D0, E, nu, D0, nodes,
+#: knot type) may differ from rod to rod.
+BATCH_KEYS = ("knot", "twist", "contact", "tighten_steps", "residual_tol")
+
+
+def batch_key(params: Mapping[str, Any]) -> tuple | None:
+    """What a case shares with the others of its batch, or None when it cannot be batched
+    (open knots: tie_batch ties closed knots only)."""
+    if params["knot"] != "closed":
+        return None
+    return tuple(params[k] for k in BATCH_KEYS)
 
 
 def build_scene(params: Mapping[str, Any], device: str = "cpu") -> KnotScene:
@@ -91,6 +105,54 @@ def run_case(params: Mapping[str, Any], device: str = "cpu") -> dict[str, Any]:
     return {"id": case.id, "params": case.params, **out,
             "wall_time_s": time.perf_counter() - start,
             "host": platform.node(), "pid": os.getpid()}
+
+
+def run_batch(params_list: list[Mapping[str, Any]], device: str = "cpu") -> list[dict[str, Any]]:
+    """The records of closed-knot cases tied together in one model
+    (:func:`tightknot.knots.batch.tie_batch`: every rod runs tie()'s own program, all rods'
+    evaluations answered by one set of launches per round), in the order given. Each
+    record is that of :func:`run_case` (the same summary, measured the same way), with
+    ``wall_time_s`` the whole batch's and ``batch`` saying which batch it was run in. Never
+    raises for failing cases: an exception gives every case of the batch status "error"."""
+    from tightknot.warp_setup import init_warp
+
+    cases = [Case.of(p) for p in params_list]
+    start = time.perf_counter()
+    try:
+        keys = {batch_key(c.params) for c in cases}
+        if None in keys or len(keys) != 1:
+            raise ValueError("a batch holds closed-knot cases that share "
+                             f"{', '.join(BATCH_KEYS)}")
+        init_warp()
+        outs = _solve_batch(cases, device)
+    except Exception as err:  # noqa: BLE001 (as run_case)
+        tb = traceback.format_exception_only(type(err), err)[-1].strip()
+        outs = [{"status": ERROR, "failure": tb, "result": None}] * len(cases)
+    wall = time.perf_counter() - start
+    host, pid = platform.node(), os.getpid()
+    return [{"id": c.id, "params": c.params, **out, "wall_time_s": wall, "host": host,
+             "pid": pid, "batch": {"rods": len(cases), "index": k}}
+            for k, (c, out) in enumerate(zip(cases, outs, strict=True))]
+
+
+def _solve_batch(cases: list[Case], device: str) -> list[dict[str, Any]]:
+    from tightknot.knots.batch import tie_batch
+    from tightknot.knots.run import measure_run
+    from tightknot.knots.tie import TieResult
+
+    scenes = [build_scene(c.params, device) for c in cases]
+    p0 = cases[0].params
+    batch = tie_batch(scenes, tighten_steps=p0["tighten_steps"], residual_tol=p0["residual_tol"])
+    outs = []
+    for sc, rod in zip(scenes, batch.rods, strict=True):
+        res = TieResult(rod.converged, rod.failure, rod.phases, rod.newton_iterations,
+                        batch.wall_time_s, rod.knot_types, 0.0, rod.system)
+        # tie()'s hook runs once per converged load step of its tightening
+        steps = sum(len(ph.steps) for ph in rod.phases.values())
+        run = measure_run(sc, res, steps)
+        outs.append({"status": OK if rod.converged else FAILED, "failure": rod.failure,
+                     "result": run.summary})
+    return outs
 
 
 def physics(record: Mapping[str, Any]) -> Any:

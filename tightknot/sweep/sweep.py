@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from tightknot.sweep.cases import Case
-from tightknot.sweep.execute import run_case
+from tightknot.sweep.execute import batch_key, run_batch, run_case
 from tightknot.sweep.executors import SerialExecutor, process_executor
 from tightknot.sweep.store import ERROR, FAILED, FINISHED, OK, Store
 
@@ -70,6 +70,27 @@ def _window(executor: Executor) -> int | None:
     return None  # a cluster schedules everything it is given
 
 
+def _units(todo: list[Case], batch: int | None) -> list[list[Case]]:
+    """The executor's tasks: one case each, or (``batch``) the closed-knot cases that share
+    a batch key in groups of at most ``batch``, placed where their first case was."""
+    if batch is None:
+        return [[c] for c in todo]
+    units: list[list[Case]] = []
+    open_group: dict[tuple, list[Case]] = {}
+    for case in todo:
+        key = batch_key(case.params)
+        if key is None:
+            units.append([case])
+            continue
+        group = open_group.get(key)
+        if group is None or len(group) >= batch:
+            group = []
+            open_group[key] = group
+            units.append(group)
+        group.append(case)
+    return units
+
+
 def run_sweep(
     cases: Iterable[Case],
     store: Store | str | Path,
@@ -79,6 +100,7 @@ def run_sweep(
     on_record: RecordHook | None = None,
     max_pending: int | None = None,
     device: str = "cpu",
+    batch: int | None = None,
 ) -> SweepReport:
     """Run every case of ``cases`` not yet finished in ``store``.
 
@@ -95,7 +117,14 @@ def run_sweep(
         max_pending: most cases submitted at once (default: 1 serial, 2 per worker for a
             process pool, all for Dask).
         device: Warp device of the workers.
+        batch: tie up to this many closed-knot cases together in one model
+            (:func:`tightknot.sweep.execute.run_batch`; cases that share
+            :data:`~tightknot.sweep.execute.BATCH_KEYS`, in the order given), each batch
+            one task of the executor; open-knot cases run one by one. None: every case
+            alone. A batch's records are stored when the whole batch is back.
     """
+    if batch is not None and not (isinstance(batch, int) and batch >= 1):
+        raise ValueError(f"batch must be None or a whole number >= 1, got {batch!r}")
     start = time.perf_counter()
     unique: dict[str, Case] = {}
     for case in cases:
@@ -123,31 +152,39 @@ def run_sweep(
         import os
 
         executor = process_executor(min(len(todo), os.cpu_count() or 1))
-    window = max_pending or _window(executor) or len(todo)
+    units = _units(todo, batch)
+    window = max_pending or _window(executor) or len(units)
     if window < 1:
         raise ValueError(f"max_pending must be >= 1, got {max_pending}")
-    pending: dict[Future, str] = {}
+    pending: dict[Future, list[str]] = {}
     position = {case.id: k for k, case in enumerate(todo)}
-    queue = list(reversed(todo))
+    queue = list(reversed(units))
     finished_ok = False
     try:
         while queue or pending:
             while queue and len(pending) < window:
-                case = queue.pop()
-                pending[executor.submit(run_case, case.params, device)] = case.id
+                unit = queue.pop()
+                if batch is None or batch_key(unit[0].params) is None:
+                    fut = executor.submit(run_case, unit[0].params, device)
+                else:
+                    fut = executor.submit(run_batch, [c.params for c in unit], device)
+                pending[fut] = [c.id for c in unit]
             done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
             # Store in submission order among those done together (stable indexes).
-            for fut in sorted(done, key=lambda f: position[pending[f]]):
-                cid = pending.pop(fut)
-                record = fut.result()  # an executor failure (a dead worker) stops the sweep
-                if record.get("id") != cid:
-                    raise RuntimeError(f"executor returned the record of {record.get('id')} "
-                                       f"for case {cid}")
-                store.put(record)
-                report.ran.append(cid)
-                report.statuses[cid] = record["status"]
-                if on_record is not None:
-                    on_record(record)
+            for fut in sorted(done, key=lambda f: position[pending[f][0]]):
+                ids = pending.pop(fut)
+                out = fut.result()  # an executor failure (a dead worker) stops the sweep
+                records = out if isinstance(out, list) else [out]
+                got = [r.get("id") for r in records]
+                if got != ids:
+                    raise RuntimeError(f"executor returned the records of {got} for the "
+                                       f"cases {ids}")
+                for record in records:
+                    store.put(record)
+                    report.ran.append(record["id"])
+                    report.statuses[record["id"]] = record["status"]
+                    if on_record is not None:
+                        on_record(record)
         finished_ok = True
     finally:
         if not finished_ok:
