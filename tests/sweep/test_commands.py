@@ -17,6 +17,8 @@ from tightknot.cli import main
     (["closed", "--poisson", "0.6"], "poisson must be in (-1, 0.5]"),
     (["open", "--force", "1", "-2"], "pull_force[1] must be > 0 N"),
     (["closed", "--scheduler", "tcp://x:1"], "--scheduler is for --executor dask"),
+    (["closed", "--batch", "0"], "--batch must be >= 1"),
+    (["open", "--force", "1", "--batch", "4"], "--batch is for closed knots"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path: Path, capsys: pytest.CaptureFixture,
                                          argv: list[str], words: str) -> None:
