@@ -114,8 +114,8 @@ def run_sweep(
         retry_failed: run again the cases stored as failed or error.
         on_record: called with each record after it is stored (progress output); an
             exception there stops the sweep (the stored records stay).
-        max_pending: most cases submitted at once (default: 1 serial, 2 per worker for a
-            process pool, all for Dask).
+        max_pending: most tasks (cases, or batches) submitted at once (default: 1
+            serial, 2 per worker for a process pool, all for Dask).
         device: Warp device of the workers.
         batch: tie up to this many closed-knot cases together in one model
             (:func:`tightknot.sweep.execute.run_batch`; cases that share
@@ -147,12 +147,12 @@ def run_sweep(
     if not todo:
         report.wall_time_s = time.perf_counter() - start
         return report
+    units = _units(todo, batch)
     owned = executor is None
     if executor is None:
         import os
 
-        executor = process_executor(min(len(todo), os.cpu_count() or 1))
-    units = _units(todo, batch)
+        executor = process_executor(min(len(units), os.cpu_count() or 1))
     window = max_pending or _window(executor) or len(units)
     if window < 1:
         raise ValueError(f"max_pending must be >= 1, got {max_pending}")
