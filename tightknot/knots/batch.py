@@ -55,7 +55,7 @@ from tightknot.knots.batch_newton import (
     run_lockstep,
 )
 from tightknot.knots.scenes import KnotScene, gauge
-from tightknot.knots.tie import knot_type_of, tie_gen
+from tightknot.knots.tie import TieResult, knot_type_of, tie_gen
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.contact import ContactLayer
 from tightknot.rods.model import Model
@@ -87,28 +87,49 @@ class BatchModel:
 
 @dataclass
 class RodOutcome:
-    """Outcome of one rod of a batch (as :class:`tightknot.knots.tie.TieResult`).
+    """Outcome of one rod of a batch: its own tie's result, and where its time went.
 
     Attributes:
-        converged: the rod reached its rest length with its knot type kept.
-        failure: what failed and where ("" when converged).
-        newton_iterations: its Newton iterations, failed attempts included.
-        knot_types: knot type after each converged step.
-        phases: the continuation result of its tightening.
+        tie: the rod's :class:`tightknot.knots.tie.TieResult` (its system: its own one-rod
+            system at the result, with its scene's contact layer, so that it evaluates on
+            its own; state in the scene's frame).
         linear: its factorizations (banded Cholesky, banded LU where it failed).
         check_s: wall-clock time of its knot-type checks [s].
-        system: its own one-rod system at the result, with its scene's contact layer, so
-            that it evaluates on its own (state in the scene's frame).
     """
 
-    converged: bool
-    failure: str
-    newton_iterations: int
-    knot_types: list[str]
-    phases: dict[str, StaticResult]
+    tie: TieResult
     linear: LinearStats
     check_s: float
-    system: RodSystem
+
+    @property
+    def converged(self) -> bool:
+        """The rod reached its rest length with its knot type kept."""
+        return self.tie.converged
+
+    @property
+    def failure(self) -> str:
+        """What failed and where ("" when converged)."""
+        return self.tie.failure
+
+    @property
+    def newton_iterations(self) -> int:
+        """Its Newton iterations, failed attempts included."""
+        return self.tie.newton_iterations
+
+    @property
+    def knot_types(self) -> list[str]:
+        """Knot type after each converged step."""
+        return self.tie.knot_types
+
+    @property
+    def phases(self) -> dict[str, StaticResult]:
+        """The continuation result of its tightening."""
+        return self.tie.phases
+
+    @property
+    def system(self) -> RodSystem:
+        """Its own one-rod system at the result."""
+        return self.tie.system
 
 
 @dataclass
@@ -213,8 +234,7 @@ def _tie_program(k: int, scene: KnotScene, evaluator: BatchEvaluator, tighten_st
     res = yield from tie_gen(scene, tighten_steps=tighten_steps, residual_tol=residual_tol,
                              relax_iterations=relax_iterations, problem=problem,
                              start_state=scene.state.copy(), knot_type=timed_knot_type)
-    return RodOutcome(res.converged, res.failure, res.newton_iterations, res.knot_types,
-                      res.phases, stats, check_s[0], res.system)
+    return RodOutcome(res, stats, check_s[0])
 
 
 def tie_batch(

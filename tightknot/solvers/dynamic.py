@@ -123,9 +123,6 @@ class ImmediateSystem(Immediate):
     """A :class:`RodSystem` as the generator solvers see it (:class:`Immediate`), with what
     the proximal steps and the load continuation ask of it besides the Newton loop."""
 
-    def __init__(self, system: RodSystem) -> None:
-        super().__init__(system)
-
     @property
     def system(self) -> RodSystem:
         return self.problem

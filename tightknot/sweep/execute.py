@@ -136,17 +136,18 @@ def run_batch(params_list: list[Mapping[str, Any]], device: str = "cpu") -> list
 
 
 def _solve_batch(cases: list[Case], device: str) -> list[dict[str, Any]]:
+    import dataclasses
+
     from tightknot.knots.batch import tie_batch
     from tightknot.knots.run import measure_run
-    from tightknot.knots.tie import TieResult
 
     scenes = [build_scene(c.params, device) for c in cases]
     p0 = cases[0].params
     batch = tie_batch(scenes, tighten_steps=p0["tighten_steps"], residual_tol=p0["residual_tol"])
     outs = []
     for sc, rod in zip(scenes, batch.rods, strict=True):
-        res = TieResult(rod.converged, rod.failure, rod.phases, rod.newton_iterations,
-                        batch.wall_time_s, rod.knot_types, 0.0, rod.system)
+        # the rod's own tie result; its time is the batch's (the rods ran together)
+        res = dataclasses.replace(rod.tie, wall_time_s=batch.wall_time_s)
         # tie()'s hook runs once per converged load step of its tightening
         steps = sum(len(ph.steps) for ph in rod.phases.values())
         run = measure_run(sc, res, steps)
