@@ -30,6 +30,7 @@ from tightknot.rods.contact_law import (
     kernel_table,
 )
 from tightknot.rods.model import Model
+from tightknot.rods.staging import Launches, Output, Staging
 from tightknot.solvers.contact_pattern import ContactPattern, pair_blocks
 from tightknot.warp_setup import init_warp
 
@@ -216,6 +217,22 @@ class ContactLayer:
                            wp.full(model.vertex_count, wp.vec3i(-1, -1, -1), dtype=wp.vec3i,
                                    device=dev))
         self._no_csc = wp.zeros(1, dtype=wp.float64, device=dev)
+        # Inputs and outputs reused from call to call, and the launches recorded over them
+        # (tightknot.rods.staging): the per-call arrays and argument packing of the four
+        # kernels were most of this layer's Python time on small rods.
+        self._in_x = Staging(wp.vec3d, dev)
+        self._in_dx = Staging(wp.vec3d, dev)
+        self._in_rest = Staging(wp.float64, dev)
+        self._lower = wp.empty(m.edge_count, dtype=wp.vec3, device=dev)
+        self._upper = wp.empty(m.edge_count, dtype=wp.vec3, device=dev)
+        self._grad_out = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
+        self._missing = wp.zeros(1, dtype=wp.int32, device=dev)
+        self._energy = Output(wp.float64, dev)
+        self._overlap = Output(wp.float64, dev)
+        self._alpha = Output(wp.float64, dev)
+        self._dist = Output(wp.float64, dev)
+        self._half_hard_memo: tuple[float, np.ndarray, wp.array] | None = None
+        self._launches = Launches()
 
     # -- buffers and detection -------------------------------------------------------------
     def _alloc(self, capacity: int) -> None:
@@ -250,13 +267,13 @@ class ContactLayer:
                     arcs: wp.array, rod_len: wp.array) -> wp.array:
         m = self.model
         dev = self.device
-        lower = wp.empty(m.edge_count, dtype=wp.vec3, device=dev)
-        upper = wp.empty(m.edge_count, dtype=wp.vec3, device=dev)
-        wp.launch(ck.edge_bounds_kernel, dim=m.edge_count, device=dev,
-                  inputs=[self._edge_vertex, wx, wdx, margin], outputs=[lower, upper])
+        lower, upper = self._lower, self._upper
+        self._launches.launch(ck.edge_bounds_kernel, m.edge_count, dev,
+                              [self._edge_vertex, wx, wdx, margin], [lower, upper])
         bvh = wp.Bvh(lower, upper)
         while True:
             self._count.zero_()
+            # Not a recorded launch: the BVH is new at every call.
             wp.launch(ck.candidate_pairs_kernel, dim=m.edge_count, device=dev,
                       inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, bvh.id,
                               lower, upper, arcs,
@@ -284,33 +301,47 @@ class ContactLayer:
                 csc: wp.array | None = None) -> tuple:
         """Detect and evaluate every candidate pair; hess_mode 0 none, 1 per-pair 144
         entries, 2 added into the CSC data ``csc`` through the block ``tables``."""
-        m = self.model
         dev = self.device
         self.rest = np.array(rest, dtype=np.float64)
-        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
+        wx = self._in_x.put(x)
         arcs, rod_len = self._arcs(rest)
         pairs = self._candidates(wx, self._zero_dx, self._margin, arcs, rod_len)
         npairs = pairs.shape[0]
-        grad = wp.zeros(m.vertex_count, dtype=wp.vec3d, device=dev)
-        missing = wp.zeros(1, dtype=wp.int32, device=dev)
+        # The gradient and the missing-block count are returned: fresh for each call, as
+        # callers may hold them; zeroed reused arrays for the kernel's sums.
+        grad, missing = self._grad_out, self._missing
+        grad.zero_()
+        missing.zero_()
         if npairs == 0:
-            return pairs, np.zeros(0), grad, None, np.zeros(0), missing
-        energy = wp.zeros(npairs, dtype=wp.float64, device=dev)
-        overlap = wp.zeros(npairs, dtype=wp.float64, device=dev)
-        hess = wp.zeros(npairs * 144 if hess_mode == 1 else 1, dtype=wp.float64, device=dev)
+            return pairs, np.zeros(0), wp.clone(grad), None, np.zeros(0), wp.clone(missing)
+        # The kernel writes every pair's energy and overlap (no zeroing needed).
+        energy = self._energy.get(npairs)
+        overlap = self._overlap.get(npairs)
+        hess = (wp.zeros(npairs * 144, dtype=wp.float64, device=dev) if hess_mode == 1
+                else self._no_csc)
         if tables is None:
             tables = self._no_tables
         if csc is None:
             csc = self._no_csc
-        wrest = wp.array(np.ascontiguousarray(rest), dtype=wp.float64, device=dev)
-        wp.launch(ck.contact_pair_kernel, dim=npairs, device=dev,
-                  inputs=[self._edge_vertex, self._edge_rod, self._rod_closed, self._radius0,
-                          self._poisson, self._modulus, self._gxi, self._gw,
-                          self._law, self._line_table, self._point_table, wx, pairs, wrest,
-                          arcs, rod_len, self._exclusion, self._local_window,
-                          int(want_grad or hess_mode > 0), hess_mode, *tables],
-                  outputs=[energy, grad, hess, overlap, csc, missing])
-        return pairs, energy.numpy(), grad, hess, overlap.numpy(), missing
+        wrest = self._in_rest.put(rest)
+        self._launches.launch(
+            ck.contact_pair_kernel, npairs, dev,
+            [self._edge_vertex, self._edge_rod, self._rod_closed, self._radius0,
+             self._poisson, self._modulus, self._gxi, self._gw,
+             self._law, self._line_table, self._point_table, wx, self._own(pairs), wrest,
+             arcs, rod_len, self._exclusion, self._local_window,
+             int(want_grad or hess_mode > 0), hess_mode, *tables],
+            [energy, grad, hess, overlap, csc, missing], variant=hess_mode)
+        return (pairs, self._energy.numpy(npairs), wp.clone(grad), hess,
+                self._overlap.numpy(npairs), wp.clone(missing))
+
+    def _own(self, pairs: wp.array) -> wp.array:
+        """The candidate buffer itself when ``pairs`` is its prefix (as ``_candidates``
+        returns it), so that the recorded launches see the same array at every call; the
+        kernels read only the first ``dim`` pairs."""
+        if pairs.ptr == self._pairs.ptr and pairs.device == self._pairs.device:
+            return self._pairs
+        return pairs
 
     def evaluate(
         self, x: np.ndarray, rest: np.ndarray, want_grad: bool = True, want_hess: bool = True
@@ -373,42 +404,52 @@ class ContactLayer:
     def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
         """Largest fraction of the step ``dx`` [m] (vertices) that keeps every non-local
         segment pair at least the hard limit apart along the straight path (1 = full)."""
-        dev = self.device
-        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
-        wdx = wp.array(np.ascontiguousarray(dx), dtype=wp.vec3d, device=dev)
+        wx = self._in_x.put(x)
+        wdx = self._in_dx.put(dx)
         arcs, rod_len = self._arcs(self.rest)
         # Sweep each edge's bounds over the step, inflated by half the hard limit.
         pairs = self._candidates(wx, wdx, self._half_hard(), arcs, rod_len)
         n = pairs.shape[0]
         if n == 0:
             return 1.0
-        alpha = wp.zeros(n, dtype=wp.float64, device=dev)
-        dist = wp.zeros(n, dtype=wp.float64, device=dev)
-        wp.launch(ck.step_bound_kernel, dim=n, device=dev,
-                  inputs=[self._edge_vertex, wx, wdx, pairs, self._hard],
-                  outputs=[alpha, dist])
-        return float(np.clip(alpha.numpy().min(), 0.0, 1.0))
+        alpha = self._step_bounds(wx, wdx, pairs)
+        return float(np.clip(alpha.min(), 0.0, 1.0))
+
+    def _step_bounds(self, wx: wp.array, wdx: wp.array, pairs: wp.array
+                     ) -> np.ndarray:
+        """The step-bound kernel over ``pairs`` (step_bound_kernel): each pair's largest
+        step fraction (host copy); the pairs' distances are left in ``self._dist``."""
+        n = pairs.shape[0]
+        alpha = self._alpha.get(n)  # written for every pair: no zeroing needed
+        dist = self._dist.get(n)
+        self._launches.launch(ck.step_bound_kernel, n, self.device,
+                              [self._edge_vertex, wx, wdx, self._own(pairs), self._hard],
+                              [alpha, dist])
+        return self._alpha.numpy(n)
 
     def _half_hard(self) -> wp.array:
-        return wp.array(0.5 * self.hard_fraction * self.edge_diameter,
-                        dtype=wp.float64, device=self.device)
+        # Kept while the hard fraction and the diameters are unchanged (they are public
+        # attributes; a caller may change them between calls).
+        memo = self._half_hard_memo
+        if (memo is not None and memo[0] == self.hard_fraction
+                and np.array_equal(memo[1], self.edge_diameter)):
+            return memo[2]
+        arr = wp.array(0.5 * self.hard_fraction * self.edge_diameter,
+                       dtype=wp.float64, device=self.device)
+        self._half_hard_memo = (self.hard_fraction, np.array(self.edge_diameter), arr)
+        return arr
 
     def _pair_distances(self, x: np.ndarray, margin: wp.array) -> tuple[np.ndarray, ...]:
         """Non-local candidate edge pairs within ``margin`` bounds and their segment
         distances [m]; also the rest arcs of the edges."""
-        dev = self.device
-        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
+        wx = self._in_x.put(x)
         arcs, rod_len = self._arcs(self.rest)
         pairs = self._candidates(wx, self._zero_dx, margin, arcs, rod_len)
         n = pairs.shape[0]
         if n == 0:
             return np.zeros((0, 2), dtype=np.int32), np.zeros(0), arcs.numpy()
-        alpha = wp.zeros(n, dtype=wp.float64, device=dev)
-        dist = wp.zeros(n, dtype=wp.float64, device=dev)
-        wp.launch(ck.step_bound_kernel, dim=n, device=dev,
-                  inputs=[self._edge_vertex, wx, self._zero_dx, pairs, self._hard],
-                  outputs=[alpha, dist])
-        return pairs.numpy(), dist.numpy(), arcs.numpy()
+        self._step_bounds(wx, self._zero_dx, pairs)
+        return pairs.numpy(), self._dist.numpy(n), arcs.numpy()
 
     def check_no_intersection(self, x: np.ndarray) -> None:
         """Refuse positions whose non-local segments are closer than the hard limit,

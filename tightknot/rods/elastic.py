@@ -1,7 +1,8 @@
 """Launchers of the elastic kernels: energy split, gradient and Hessian of a model's rods.
 
 Thin functions over :mod:`tightknot.rods.elastic_kernels`; they take host NumPy arrays
-(zero-copy on CPU) and the slot maps of a :class:`tightknot.solvers.linear.SparsePattern`.
+(copied into reused device arrays, :mod:`tightknot.rods.staging`) and the slot maps of a
+:class:`tightknot.solvers.linear.SparsePattern`.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import warp as wp
 
 from tightknot.rods import elastic_kernels as ek
 from tightknot.rods.model import Model
+from tightknot.rods.staging import Launches, Staging
 from tightknot.warp_setup import init_warp
 
 
@@ -28,14 +30,6 @@ class ElasticEnergies:
     def total(self) -> float:
         """Sum of the three [J]."""
         return self.stretch + self.bend + self.twist
-
-
-def _vec3(a: np.ndarray, device: str) -> wp.array:
-    return wp.array(np.ascontiguousarray(a, dtype=np.float64), dtype=wp.vec3d, device=device)
-
-
-def _f64(a: np.ndarray, device: str) -> wp.array:
-    return wp.array(np.ascontiguousarray(a, dtype=np.float64), dtype=wp.float64, device=device)
 
 
 class ElasticForces:
@@ -60,6 +54,20 @@ class ElasticForces:
         self._grad = wp.zeros(model.dof_count, dtype=wp.float64, device=dev)
         self._empty_slots = wp.zeros((1, 1), dtype=wp.int32, device=dev)
         self._empty_f = wp.zeros(1, dtype=wp.float64, device=dev)
+        # Inputs and outputs reused from call to call, and the launches recorded over
+        # them (tightknot.rods.staging: the per-call array creation and argument packing
+        # were a fifth of a small rod's Newton iteration).
+        self._in_x = Staging(wp.vec3d, dev)
+        self._in_theta = Staging(wp.float64, dev)
+        self._in_mref = Staging(wp.float64, dev)
+        self._in_rest = Staging(wp.float64, dev)
+        self._in_d1 = Staging(wp.vec3d, dev)
+        self._in_t = Staging(wp.vec3d, dev)
+        self._in_mref_base = Staging(wp.float64, dev)
+        self._d1 = wp.empty(model.edge_count, dtype=wp.vec3d, device=dev)
+        self._t = wp.empty(model.edge_count, dtype=wp.vec3d, device=dev)
+        self._mref = wp.empty(max(model.joint_count, 1), dtype=wp.float64, device=dev)
+        self._launches = Launches()
         self.set_slots(joint_slot, edge_slot)
 
     def set_slots(self, joint_slot: np.ndarray | None, edge_slot: np.ndarray | None) -> None:
@@ -87,10 +95,10 @@ class ElasticForces:
         """
         m = self.model
         dev = self.device
-        wx = _vec3(x, dev)
-        wth = _f64(theta, dev) if m.twist else self._empty_f
-        wmr = _f64(m_ref, dev)
-        wrest = _f64(edge_rest_length, dev)
+        wx = self._in_x.put(x)
+        wth = self._in_theta.put(theta) if m.twist else self._empty_f
+        wmr = self._in_mref.put(m_ref)
+        wrest = self._in_rest.put(edge_rest_length)
         want_hess = hess_data is not None
         if want_hess and self._jslot is None:
             raise RuntimeError("ElasticForces has no Hessian slot map (call set_slots)")
@@ -100,20 +108,21 @@ class ElasticForces:
         jslot = self._jslot if want_hess else self._empty_slots
         eslot = self._eslot if want_hess else self._empty_slots
         wg, wh = int(want_grad or want_hess), int(want_hess)
+        launch = self._launches.launch
         if m.edge_count:
-            wp.launch(
-                ek.stretch_kernel, dim=m.edge_count, device=dev,
-                inputs=[m.wp("edge_vertex"), m.wp("edge_mu_area"), m.wp("edge_dofs"),
-                        wx, wrest, eslot, wg, wh],
-                outputs=[self._e_stretch, self._grad, hout],
+            launch(
+                ek.stretch_kernel, m.edge_count, dev,
+                [m.wp("edge_vertex"), m.wp("edge_mu_area"), m.wp("edge_dofs"),
+                 wx, wrest, eslot, wg, wh],
+                [self._e_stretch, self._grad, hout], variant=wh,
             )
         if m.joint_count:
-            wp.launch(
-                ek.bend_twist_kernel, dim=m.joint_count, device=dev,
-                inputs=[m.wp("joint_vertex"), m.wp("joint_edge"), m.wp("joint_bend_stiffness"),
-                        m.wp("joint_twist_stiffness"), m.wp("joint_thinning_exponent"),
-                        m.wp("joint_dofs"), int(m.twist), wx, wth, wmr, wrest, jslot, wg, wh],
-                outputs=[self._e_bend, self._e_twist, self._grad, hout],
+            launch(
+                ek.bend_twist_kernel, m.joint_count, dev,
+                [m.wp("joint_vertex"), m.wp("joint_edge"), m.wp("joint_bend_stiffness"),
+                 m.wp("joint_twist_stiffness"), m.wp("joint_thinning_exponent"),
+                 m.wp("joint_dofs"), int(m.twist), wx, wth, wmr, wrest, jslot, wg, wh],
+                [self._e_bend, self._e_twist, self._grad, hout], variant=wh,
             )
         energies = ElasticEnergies(
             stretch=float(self._e_stretch.numpy().sum()) if m.edge_count else 0.0,
@@ -130,13 +139,13 @@ class ElasticForces:
         transport from the base frames (Bergou 2010 sec. 4.1). Returns (d1, t, m_ref)."""
         m = self.model
         dev = self.device
-        d1 = wp.empty(m.edge_count, dtype=wp.vec3d, device=dev)
-        t = wp.empty(m.edge_count, dtype=wp.vec3d, device=dev)
-        mref = wp.empty(max(m.joint_count, 1), dtype=wp.float64, device=dev)
-        wp.launch(ek.transport_frames_kernel, dim=m.edge_count, device=dev,
-                  inputs=[m.wp("edge_vertex"), _vec3(x, dev), _vec3(d1_base, dev),
-                          _vec3(t_base, dev)], outputs=[d1, t])
+        d1, t, mref = self._d1, self._t, self._mref
+        self._launches.launch(ek.transport_frames_kernel, m.edge_count, dev,
+                              [m.wp("edge_vertex"), self._in_x.put(x), self._in_d1.put(d1_base),
+                               self._in_t.put(t_base)], [d1, t])
         if m.joint_count:
-            wp.launch(ek.reference_twist_kernel, dim=m.joint_count, device=dev,
-                      inputs=[m.wp("joint_edge"), d1, t, _f64(m_ref_base, dev)], outputs=[mref])
-        return d1.numpy(), t.numpy(), mref.numpy()[: m.joint_count]
+            self._launches.launch(ek.reference_twist_kernel, m.joint_count, dev,
+                                  [m.wp("joint_edge"), d1, t, self._in_mref_base.put(m_ref_base)],
+                                  [mref])
+        # Copies: the arrays are overwritten by the next call, the results are kept.
+        return d1.numpy().copy(), t.numpy().copy(), mref.numpy()[: m.joint_count].copy()

@@ -22,6 +22,7 @@ import warp as wp
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.elastic import ElasticForces
 from tightknot.rods.model import Model
+from tightknot.rods.staging import Output
 from tightknot.rods.state import State
 from tightknot.solvers.contact_pattern import ContactPattern
 from tightknot.solvers.linear import SparsePattern
@@ -125,6 +126,7 @@ class RodSystem:
         self.t = 0.0
         self.last_split = EnergySplit()
         self._cpattern: ContactPattern | None = None
+        self._cdata = Output(wp.float64, model.device)
         self._trial: tuple[np.ndarray, ...] | None = None
         self.set_load(0.0)
 
@@ -205,7 +207,9 @@ class RodSystem:
             if self._cpattern is None:
                 self._cpattern = ContactPattern(m, self.pattern)
             while True:
-                cdata = wp.zeros(self._cpattern.nnz, dtype=wp.float64, device=m.device)
+                # One reused array (its first nnz entries zeroed), so that the contact
+                # kernel's recorded launch sees the same target at every evaluation.
+                cdata = self._cdata.get(self._cpattern.nnz, zero=True)
                 for term in direct:
                     results[id(term)] = term.evaluate_into(x, self.rest, self._cpattern, cdata)
                     if results[id(term)][1] is None:
@@ -239,7 +243,7 @@ class RodSystem:
             pattern = self.pattern
             if cdata is not None:
                 pattern = self._cpattern
-                full = cdata.numpy()
+                full = self._cdata.numpy(pattern.nnz)
                 full[pattern.elastic_slot] += data
                 data = full
             if self.inertia is not None:
