@@ -79,3 +79,10 @@ def test_bad_input():
         tradeoff._grid({"closed_trefoil": {"nodes": (40,), "levels": ("bogus",),
                                            "level_nodes": (40,)}}, (1e-3,))
     assert main(["bench", "batch", "--nodes", "10"]) == 2
+
+
+def test_scaling_refuses_a_coil_tighter_than_its_rod(capsys):
+    # One line naming the parameter and its range, exit 2, before any work.
+    assert main(["bench", "scaling", "--sizes", "100", "--helix-radius", "0.5"]) == 2
+    err = capsys.readouterr().err
+    assert "helix_radius must be >= 0.75" in err and len(err.strip().splitlines()) == 1
