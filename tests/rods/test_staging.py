@@ -116,3 +116,19 @@ def test_a_contact_layer_called_again_equals_a_fresh_one() -> None:
     np.testing.assert_array_equal(fresh[1], again[1])
     for a, b in zip(fresh[2], again[2], strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_the_device_branches_copy_and_zero_as_the_host_ones() -> None:
+    # On a GPU the arrays have no host view: put() assigns, get(zero=True) zeroes the whole
+    # array, numpy() copies back. Run those branches on CPU arrays by dropping the view.
+    s = Staging(wp.vec3d, "cpu")
+    s.put(np.zeros((3, 3)))
+    s._view = None
+    a = np.arange(9.0).reshape(3, 3)
+    np.testing.assert_array_equal(s.put(a).numpy(), a)
+    o = Output(wp.float64, "cpu")
+    arr = o.get(3)
+    arr.assign(np.array([1.0, 2.0, 3.0, 4.0]))
+    o._view = None
+    assert o.get(3, zero=True) is arr
+    np.testing.assert_array_equal(o.numpy(3), 0.0)
