@@ -331,7 +331,8 @@ class ContactLayer:
              self._law, self._line_table, self._point_table, wx, self._own(pairs), wrest,
              arcs, rod_len, self._exclusion, self._local_window,
              int(want_grad or hess_mode > 0), hess_mode, *tables],
-            [energy, grad, hess, overlap, csc, missing], variant=hess_mode)
+            [energy, grad, hess, overlap, csc, missing],
+            variant=(int(want_grad or hess_mode > 0), hess_mode))
         return (pairs, self._energy.numpy(npairs), wp.clone(grad), hess,
                 self._overlap.numpy(npairs), wp.clone(missing))
 

@@ -114,7 +114,7 @@ class ElasticForces:
                 ek.stretch_kernel, m.edge_count, dev,
                 [m.wp("edge_vertex"), m.wp("edge_mu_area"), m.wp("edge_dofs"),
                  wx, wrest, eslot, wg, wh],
-                [self._e_stretch, self._grad, hout], variant=wh,
+                [self._e_stretch, self._grad, hout], variant=(wg, wh),
             )
         if m.joint_count:
             launch(
@@ -122,7 +122,7 @@ class ElasticForces:
                 [m.wp("joint_vertex"), m.wp("joint_edge"), m.wp("joint_bend_stiffness"),
                  m.wp("joint_twist_stiffness"), m.wp("joint_thinning_exponent"),
                  m.wp("joint_dofs"), int(m.twist), wx, wth, wmr, wrest, jslot, wg, wh],
-                [self._e_bend, self._e_twist, self._grad, hout], variant=wh,
+                [self._e_bend, self._e_twist, self._grad, hout], variant=(wg, wh),
             )
         energies = ElasticEnergies(
             stretch=float(self._e_stretch.numpy().sum()) if m.edge_count else 0.0,
