@@ -77,8 +77,8 @@ def coiled_rod(n: int, helix_radius: float = RADIUS) -> np.ndarray:
     """A helix of n vertices [m] and radius ``helix_radius`` D0, turns touching (module
     docstring)."""
     if not (math.isfinite(helix_radius) and helix_radius >= 0.75):
-        # A tighter coil bends the rod beyond kappa D0 = 4/3, its inner fibre to a third of
-        # a diameter from the axis: outside what this benchmark is meant to load.
+        # A tighter coil bends the rod beyond kappa D0 = 4/3, its inner fibre within a quarter
+        # of a diameter of the helix axis: outside what this benchmark is meant to load.
         raise ValueError(f"helix_radius must be >= 0.75 (in D0), got {helix_radius!r}")
     d = DIAMETER
     r, pitch = helix_radius * d, PITCH * d
