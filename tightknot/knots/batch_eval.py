@@ -32,7 +32,6 @@ import numpy as np
 import scipy.sparse as sp
 import warp as wp
 
-from tightknot.rods import contact_kernels as ck
 from tightknot.rods import elastic_kernels as ek
 from tightknot.rods.contact import ContactLayer
 from tightknot.rods.elastic import ElasticForces
@@ -109,10 +108,9 @@ class BatchContactLayer(ContactLayer):
         """Largest fraction in [0, 1] of the step ``dx`` [m] of each rod in mask ``rods``
         that keeps its non-local segment pairs at least the hard limit apart (as
         :meth:`max_step`)."""
-        dev = self.device
         self.rest = np.array(rest, dtype=np.float64)
-        wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=dev)
-        wdx = wp.array(np.ascontiguousarray(dx), dtype=wp.vec3d, device=dev)
+        wx = self._in_x.put(x)
+        wdx = self._in_dx.put(dx)
         arcs, rod_len = self._arcs(self.rest)
         self.rod_mask = rods
         try:
@@ -123,13 +121,9 @@ class BatchContactLayer(ContactLayer):
         n = pairs.shape[0]
         if n == 0:
             return out
-        alpha = wp.zeros(n, dtype=wp.float64, device=dev)
-        dist = wp.zeros(n, dtype=wp.float64, device=dev)
-        wp.launch(ck.step_bound_kernel, dim=n, device=dev,
-                  inputs=[self._edge_vertex, wx, wdx, pairs, self._hard],
-                  outputs=[alpha, dist])
+        alpha = self._step_bounds(wx, wdx, pairs)
         rod = self.model.edge_rod[pairs.numpy()[:, 0]]
-        np.minimum.at(out, rod, np.clip(alpha.numpy(), 0.0, 1.0))
+        np.minimum.at(out, rod, np.clip(alpha, 0.0, 1.0))
         return out
 
 

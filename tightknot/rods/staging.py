@@ -20,8 +20,6 @@ from typing import Any
 import numpy as np
 import warp as wp
 
-_VEC_WIDTH = {wp.vec2d: 2, wp.vec3d: 3, wp.vec2i: 2, wp.vec3: 3, wp.vec3i: 3}
-
 
 class Staging:
     """One device array, refilled from host data of a fixed length.
