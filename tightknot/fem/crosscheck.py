@@ -56,7 +56,10 @@ than the nominal approach, so it admits more levels: the stricter gate.
 
 Diagnostics (``diagnostics``, not timed, not part of ``passed``): the indent's axial force
 at the crossing in both models, and the rod model with nu = 0 (a contact radius that does
-not thin with stretch): where the indent's force deficit comes from.
+not thin with stretch): where the indent's force deficit comes from; the indent's contact
+footprint in both models (``indent_footprint``); the wrap with variants of the pair kernel
+(``wrap_kernel_variants``, :mod:`tightknot.fem.wrap_variants`): where the wrap's line-load
+deficit does not come from.
 
 Wall time. ``fem_over_rod_time_ratio`` is the FEM wall time of the compared runs (one mesh
 each, all load levels) over the rod model's (all levels, model set-up included, after
@@ -220,6 +223,10 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
         # the pair's forces are equal and opposite: the upper indenter's (on it, -g) is the
         # magnitude of the force on the rod
         force = -float(g[up_v, 1].sum())
+        # footprint: rms distance of the upper indenter's contact force from the crossing,
+        # along the indenter (by the 90-degree symmetry of the kernel also along the rod)
+        f_up = -g[up_v, 1]
+        rms = math.sqrt(float((f_up * x[up_v, 0] ** 2).sum()) / force) if force > 0 else 0.0
         # axial force in the mid section (tension > 0): the contact forces' z components
         # on the z > 0 half (force on the rod: -g)
         axial = -float(g[rod_v[mid + 1:], 2].sum())
@@ -241,6 +248,7 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "area_ratio_mid": float(law.area_factor(w_side, d0)) / stretch,
             "peak_pressure_over_e": float(law.peak_pressure_point(w_side, d0)),
             "semi_axis_over_d0": float(law._power(law.k_patch, law.p_patch, w_side, d0)),
+            "force_rms_halfwidth_over_d0": rms / d0,
         }
 
     rows = _solve_levels(system, path, list(w_levels), measure)
@@ -436,6 +444,74 @@ def _indent_diagnostics(fem: dict[str, Any], rod: dict[str, Any], length_over_d0
     }
 
 
+#: Footprint of the rod model's force over a Hertz patch's: a patch of semi-axis a with an
+#: elliptical pressure has a line density (1 - x^2/a^2) along a diameter, whose rms is
+#: a/sqrt(5) (Johnson 1985, sec. 4.2).
+HERTZ_RMS_TO_SEMI_AXIS: float = math.sqrt(5.0)
+
+#: Kernel variants of the wrap diagnostic (tightknot.fem.wrap_variants): the shipped
+#: kernel (re-implemented, as a check), its footprint shrunk to the Hertz patch, the line law.
+WRAP_VARIANTS: tuple[tuple[str, float], ...] = (("point", 1.0), ("point", 2.0), ("line", 1.0))
+
+
+def _indent_footprint(fem: dict[str, Any], rod: dict[str, Any]) -> dict[str, Any]:
+    """The rod model's contact footprint along the indenter against the FEM's patch."""
+    rows = []
+    for f, r in zip(fem["steps"], rod["steps"], strict=True):
+        if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9:
+            continue
+        a_rod = HERTZ_RMS_TO_SEMI_AXIS * r["force_rms_halfwidth_over_d0"]
+        a_fem = f.get("semi_axis_transverse_over_d0")
+        rows.append({
+            "approach_over_d0": f["approach_over_d0"],
+            "rod_equivalent_semi_axis_over_d0": a_rod,
+            "fem_semi_axis_transverse_over_d0": a_fem,
+            "fem_semi_axis_axial_over_d0": f.get("semi_axis_axial_over_d0"),
+            "rod_over_fem_semi_axis": a_rod / a_fem if a_fem else None,
+            "kernel_reach_over_d0": math.sqrt(max(2.0 * r["overlap_over_d0"], 0.0)),
+        })
+    return {
+        "what": "diagnostic: the semi-axis of a Hertz patch with the rms spread of the rod "
+                "model's force on the indenter (sqrt(5) rms), against the FEM's patch; the "
+                "kernel reaches sqrt(R^2 - d^2) ~ sqrt(2 R delta) along each strand",
+        "levels": rows,
+    }
+
+
+def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
+    """The wrap with kernel variants (:mod:`tightknot.fem.wrap_variants`) against the FEM."""
+    from .wrap_variants import rod_wrap_variant
+
+    wp_ = fem_wrap["parameters"]
+    out = []
+    for kernel, footprint in WRAP_VARIANTS:
+        res = rod_wrap_variant([s["tension"] for s in fem_wrap["steps"]], kernel=kernel,
+                               footprint=footprint, wrap_angle_deg=wp_["wrap_angle_deg"],
+                               diameter=wp_["diameter_m"],
+                               youngs_modulus=wp_["youngs_modulus_pa"],
+                               length_over_d0=wp_["segment_length_m"] / wp_["diameter_m"])
+        levels = []
+        for f, r in zip(fem_wrap["steps"], res["steps"], strict=True):
+            if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9:
+                continue
+            levels.append({
+                "tension_over_e_d0sq": f["tension_over_e_d0sq"],
+                "force_rel": relative(r["force_per_length_mid"],
+                                      f["force_per_length_mid_nominal"]),
+                "curvature_rel": relative(r["kappa_d0_mid"], f["kappa_d0_mid_nominal"]),
+                "rod_contact_half_length_over_d0": r["contact_half_length_over_d0"],
+                "converged": bool(r["converged"]),
+            })
+        out.append({"kernel": kernel, "footprint": footprint, "levels": levels,
+                    "wall_time_s": res["wall_time_s"]})
+    return {
+        "what": "diagnostic: the wrap's mid line load and curvature with variants of the "
+                "pair kernel (tightknot/fem/wrap_variants.py: point kernel with its "
+                "footprint shrunk by 'footprint', or the line law), relative to the FEM",
+        "variants": out,
+    }
+
+
 def _warm_up() -> float:
     """Build and solve a tiny contact problem once so that Warp compiles its kernels
     outside the timed runs; return the time it took [s]."""
@@ -476,6 +552,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
                       length_over_d0=wp_["segment_length_m"] / wp_["diameter_m"])
     ind_len = fem_ind["parameters"]["segment_length_m"] / d0
     diagnostics = _indent_diagnostics(fem_ind, rod_ind, ind_len)
+    diagnostics["indent_footprint"] = _indent_footprint(fem_ind, rod_ind)
+    diagnostics["wrap_kernel_variants"] = _wrap_variants(fem_wrap)
     fem_time = fem_ind["wall_time_s"] + fem_wrap["wall_time_s"]
     rod_time = rod_ind["wall_time_s"] + rod_wr["wall_time_s"]
     scenes = {
