@@ -24,7 +24,7 @@ def _length(x: np.ndarray, closed: bool) -> float:
 
 # -- bad input -------------------------------------------------------------------------------
 @pytest.mark.parametrize("kwargs, match", [
-    ({"contact": "soft"}, "contact must be one of compliant, rigid, off"),
+    ({"contact": "soft"}, "contact must be one of compliant, smoothed, rigid, off"),
     ({"twist": "yes"}, "twist must be True or False"),
     ({"contact": "off", "law": RadialComplianceLaw.hertz()}, "contact='off'"),
     ({"law": RadialComplianceLaw.hertz().rigid_tube()}, "use contact='rigid'"),
@@ -141,3 +141,43 @@ def test_twist_off_gives_the_shape_of_twist_on_for_an_isotropic_closed_knot() ->
     rb = analyze_centerline(xb, d0, True, rest_length=sb.rest_length)
     assert np.max(np.abs(np.subtract(ra["rho"], rb["rho"]))) < 0.02
     assert np.max(np.abs(np.subtract(ra["z"], rb["z"]))) < 0.02
+
+
+def test_smoothed_level_ties_the_same_closed_trefoil() -> None:
+    # The "smoothed" level thins the sections with the stretch averaged over +-1 D0 along
+    # the rod: in a closed knot the tension is nearly uniform, so the knot is the same
+    # (measured at 100 vertices: stretch 1.07470 against 1.07476, 320 Newton iterations
+    # against 327). Tolerance 2e-3 on the stretch: 30 times that difference, a tenth of
+    # the stretch's excess over 1 (a broken chain rule stalls or shifts it by more).
+    out = {}
+    for level in ("compliant", "smoothed"):
+        scene = closed_trefoil(nodes=48, contact=level)
+        assert scene.info["model"]["contact"] == level
+        res = tie(scene)
+        assert res.converged, res.failure
+        assert set(res.knot_types) == {"3_1"}
+        x = res.system.state.x
+        out[level] = (scene, x, _length(x, True) / scene.rest_length, res.newton_iterations)
+    sm, x, stretch, its = out["smoothed"]
+    assert sm.contact.radius_window == 1.0
+    assert stretch == pytest.approx(out["compliant"][2], abs=2e-3)
+    assert its < 3 * out["compliant"][3]  # Newton keeps its pace (exact Hessian)
+    # the reported radii are those of the smoothed stretch
+    r_e, _ = vertex_radii(sm, x, sm.model.edge_rest_length)
+    lam = sm.contact.section_stretch(x, sm.model.edge_rest_length)
+    np.testing.assert_allclose(r_e, sm.diameter / 2 * lam**-0.5, rtol=1e-12)
+
+
+def test_smoothed_level_refusals() -> None:
+    from tightknot.knots.batch import tie_batch
+    from tightknot.sweep.execute import batch_key
+
+    with pytest.raises(ValueError, match="rigid-tube law"):
+        closed_trefoil(nodes=40, contact="smoothed", law=RadialComplianceLaw.from_json()
+                       .rigid_tube())
+    with pytest.raises(ValueError, match="does not support a contact layer with radius_window"):
+        tie_batch([closed_trefoil(nodes=40, contact="smoothed")] * 2)
+    params = {"knot": "closed", "twist": True, "contact": "smoothed", "tighten_steps": 40,
+              "residual_tol": 1e-6}
+    assert batch_key(params) is None  # a sweep with --batch ties these one by one
+    assert batch_key({**params, "contact": "compliant"}) is not None

@@ -129,6 +129,11 @@ class BatchContactLayer(ContactLayer):
 
 def batch_contact_layer(model: Model, like: ContactLayer) -> BatchContactLayer:
     """A :class:`BatchContactLayer` on ``model`` with the settings of ``like``."""
+    if getattr(like, "radius_window", 0.0) > 0.0:
+        # Its Hessian couples whole windows of the rod: not the banded per-rod systems of
+        # the batch (tightknot.rods.section_radius).
+        raise ValueError(f"the batch does not support a contact layer with radius_window > 0 "
+                         f"(got {like.radius_window:g} D0): tie these scenes one by one")
     law_params = like._law.numpy()
     return BatchContactLayer(
         model, like.law, gauss_points=like._gxi.shape[0],

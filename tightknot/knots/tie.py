@@ -165,7 +165,7 @@ def tie_gen(
     knot type computed by ``knot_type``. Returns the :class:`TieResult`."""
     if scene.contact is None:
         raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
-                         "the rod passes through itself); use 'compliant' or 'rigid'")
+                         "the rod passes through itself); use 'compliant', 'smoothed' or 'rigid'")
     if pull_force is not None and end_distance is not None:
         raise ValueError("give pull_force or end_distance, not both")
     if scene.closed and (pull_force is not None or end_distance is not None):

@@ -330,6 +330,11 @@ def contact_pair_kernel(
     local_window: wp.float64,
     want_grad: int,
     want_hess: int,
+    # Contact radii given per edge (radius_given = 1): the energy then depends on the
+    # positions at FIXED radii (no derivative through the edge lengths), and dR_out gets,
+    # per pair, [dE/dR, d2E/dR2, d(grad)/dR (4 vertices x 3)] with R = r_a + r_b.
+    radius_in: wp.array(dtype=wp.float64),
+    radius_given: int,
     # Hessian target (want_hess = 1: 144 entries per pair in hess_out; 2: added into the
     # CSC data array csc_out through the block table, see scatter_block):
     block_keys: wp.array(dtype=wp.int64),
@@ -343,6 +348,7 @@ def contact_pair_kernel(
     overlap_out: wp.array(dtype=wp.float64),
     csc_out: wp.array(dtype=wp.float64),
     missing_out: wp.array(dtype=wp.int32),
+    dR_out: wp.array(dtype=wp.float64),
 ):
     p = wp.tid()
     pr = pairs_in[p]
@@ -377,6 +383,9 @@ def contact_pair_kernel(
     nub = edge_poisson[b]
     r_a = edge_radius0[a] * wp.pow(la / edge_rest_length_in[a], -nua)
     r_b = edge_radius0[b] * wp.pow(lb / edge_rest_length_in[b], -nub)
+    if radius_given != 0:
+        r_a = radius_in[a]
+        r_b = radius_in[b]
     R = r_a + r_b
     # Most candidates do not interact: find the closest Gauss pair first and leave before
     # the pair constants (powers) when it lies outside the contact radius.
@@ -415,6 +424,9 @@ def contact_pair_kernel(
                 if ss < lim * lim:
                     local_hit = 1
     if s_min >= R * R and local_hit == 0:
+        if radius_given != 0 and want_grad != 0:
+            for k in range(14):
+                dR_out[p * 14 + k] = f64(0.0)
         energy_out[p] = f64(0.0)
         overlap_out[p] = R - wp.sqrt(s_min)
         return
@@ -434,6 +446,17 @@ def contact_pair_kernel(
     R_b = -nub * r_b / lb
     R_aa = nua * (nua + f64(1.0)) * r_a / (la * la)
     R_bb = nub * (nub + f64(1.0)) * r_b / (lb * lb)
+    if radius_given != 0:
+        R_a = f64(0.0)
+        R_b = f64(0.0)
+        R_aa = f64(0.0)
+        R_bb = f64(0.0)
+    eR = f64(0.0)
+    eRR = f64(0.0)
+    gR0 = wp.vec3d()
+    gR1 = wp.vec3d()
+    gR2 = wp.vec3d()
+    gR3 = wp.vec3d()
     # Angle: c = ta . tb, q = c^2 and its gradients in e_a, e_b.
     c = wp.dot(ta, tb)
     q = c * c
@@ -624,6 +647,21 @@ def contact_pair_kernel(
             g1 += xg * grad_r + grad_a
             g2 += -(f64(1.0) - xh) * grad_r - grad_b
             g3 += -xh * grad_r + grad_b
+            if radius_given != 0:
+                # d/dR at fixed positions (R_a = R_b = 0 here): Pz = (Ps, 0, 0, Pq)
+                eR += wgt * P * PR
+                eRR += wgt * P * PRR
+                dF0 = wgt * P * PsR
+                dF1 = wgt * PR * lb
+                dF2 = wgt * PR * la
+                dF3 = wgt * P * PRq
+                dgr = dF0 * gr_s
+                dga = dF1 * ga_la + dF3 * dq_a
+                dgb = dF2 * gb_lb + dF3 * dq_b
+                gR0 += (f64(1.0) - xg) * dgr - dga
+                gR1 += xg * dgr + dga
+                gR2 += -(f64(1.0) - xh) * dgr - dgb
+                gR3 += -xh * dgr + dgb
             if want_hess == 0:
                 continue
             Fzz = wgt * (P * Pzz + wp.outer(Pp, Pz) + wp.outer(Pz, Pp))
@@ -711,6 +749,15 @@ def contact_pair_kernel(
                   csc_out, missing_out, verts, 3, 3, m33)
     energy_out[p] = energy
     overlap_out[p] = xmax
+    if radius_given != 0 and want_grad != 0:
+        o = p * 14
+        dR_out[o] = eR
+        dR_out[o + 1] = eRR
+        for i in range(3):
+            dR_out[o + 2 + i] = gR0[i]
+            dR_out[o + 5 + i] = gR1[i]
+            dR_out[o + 8 + i] = gR2[i]
+            dR_out[o + 11 + i] = gR3[i]
     if want_grad != 0:
         wp.atomic_add(grad_out, va[0], g0)
         wp.atomic_add(grad_out, va[1], g1)

@@ -218,8 +218,10 @@ class RodSystem:
                     break
         for term in self.extra_terms:
             if id(term) in results:
-                e_k, g_k = results[id(term)]
-                h_k = None
+                # (energy, gradient) or, from a contact layer with a radius window, also the
+                # COO Hessian terms outside its pair blocks
+                e_k, g_k, *rest_k = results[id(term)]
+                h_k = rest_k[0] if rest_k else None
             else:
                 e_k, g_k, h_k = term.evaluate(x, self.rest, want_grad or want_hess, want_hess)
             split.extra[term.name] = e_k

@@ -14,8 +14,9 @@ Parameters (SI units):
 * ``nodes``: vertices (>= 24 closed, >= 40 open; default 200 closed, 300 open).
 * ``diameter`` D0 [m] (8.5e-3), ``youngs_modulus`` E [Pa] (1.25e6), ``poisson`` nu
   (0.5, in (-1, 0.5]), ``density`` [kg/m^3] (1160; only the proximal fallback uses it).
-* ``contact``: "compliant" (the FEM-calibrated radial-compliance law) or "rigid" (the
-  rigid-tube law, 1e3 times stiffer, radius not thinned by stretch).
+* ``contact``: "compliant" (the FEM-calibrated radial-compliance law), "smoothed" (the
+  same law, the section thinned by the stretch averaged over +-1 D0; not with ``--batch``)
+  or "rigid" (the rigid-tube law, 1e3 times stiffer, radius not thinned by stretch).
 * ``twist``: twist dofs on or off (default on for closed, off for open knots: an isotropic
   rod with twist-free ends relaxes its twist to zero).
 * closed: ``l0_over_d0`` L0/D0 (16.37, >= 10).
@@ -40,7 +41,7 @@ from typing import Any
 _ID_SCHEMA = "tightknot-sweep-case-v1"
 
 KNOTS = ("closed", "open")
-CONTACT_LAWS = ("compliant", "rigid")
+CONTACT_LAWS = ("compliant", "smoothed", "rigid")
 LEVEL_KEYS = ("pull_force", "target_lambda")
 
 _COMMON_DEFAULTS: dict[str, Any] = {
