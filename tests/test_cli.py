@@ -91,6 +91,19 @@ def test_tie_run_folder_holds_every_output(closed_run: Path) -> None:
     assert cfg["device"] == "cpu"  # what ran, not "the default"
 
 
+def test_tie_contact_level_flag_reaches_the_scene(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    assert main(["tie", "closed", "--nodes", "48", "--quiet", "--contact", "smoothed",
+                 "--out", str(out)]) == 0
+    cfg = json.loads((out / "config.json").read_text())
+    assert cfg["contact"] == "smoothed"
+    data = _summary(out)
+    assert data["converged"] is True and data["knot_type"] == "3_1"
+    with pytest.raises(SystemExit) as bad:  # argparse's choices: one line, exit code 2
+        main(["tie", "closed", "--contact", "sticky"])
+    assert bad.value.code == 2
+
+
 def test_tie_rrd_has_rod_contacts_series_steps_and_final_centerline(closed_run: Path) -> None:
     from tightknot.viz.rrd_read import entity_paths, last_points3d, scalar_series, steps
 

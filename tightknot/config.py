@@ -70,6 +70,8 @@ _SPEC: dict[str, tuple[type, Any, str, str]] = {
                      "Newton tolerance on the scaled residual"),
     "relax_iterations": (int, _Range(1, 1_000_000), "",
                          "Newton budget of the start curve's relaxation"),
+    "contact": (str, ("compliant", "smoothed", "rigid"), "",
+                "contact level (tightknot.knots.scenes: what each neglects)"),
     "color_by": (str, COLOR_FIELDS, "", "field colouring the rod tube in the .rrd"),
     "device": (str, None, "", "Warp device, e.g. cpu or cuda:0"),
 }
@@ -106,6 +108,7 @@ class TieConfig:
     pull_steps: int = 10
     residual_tol: float = 1e-6
     relax_iterations: int = 2000
+    contact: str = "compliant"
     color_by: str = "kappa_D0"
     device: str | None = None
 

@@ -189,7 +189,6 @@ class ContactLayer:
         self._rod_closed = wp.array([int(r.closed) for r in m.rods], dtype=wp.int32, device=dev)
         self._radius0 = wp.array(m.edge_radius, dtype=f64, device=dev)
         self._poisson = wp.array(nu, dtype=f64, device=dev)
-        self.edge_poisson = nu
         self.radius_window = float(radius_window)
         self._smooth = None
         if self.radius_window > 0.0:
@@ -323,7 +322,9 @@ class ContactLayer:
                 tables: tuple[wp.array, ...] | None = None,
                 csc: wp.array | None = None, radius: wp.array | None = None) -> tuple:
         """Detect and evaluate every candidate pair; hess_mode 0 none, 1 per-pair 144
-        entries, 2 added into the CSC data ``csc`` through the block ``tables``."""
+        entries, 2 added into the CSC data ``csc`` through the block ``tables``. ``radius``:
+        the contact radius of each edge [m] (the smoothed radius); the kernel then also
+        writes each pair's dE/dR, d2E/dR2 and d(grad)/dR into ``self._dR`` (14 per pair)."""
         dev = self.device
         self.rest = np.array(rest, dtype=np.float64)
         wx = self._in_x.put(x)
