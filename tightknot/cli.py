@@ -351,8 +351,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="Newton budget of the start curve's relaxation (2000)")
     p.add_argument("--contact", default=None, choices=["compliant", "smoothed", "rigid"],
                    help="contact level: compliant (default), smoothed (sections thinned by "
-                   "the stretch averaged over +-1 D0: closer to the FEM at a crossing, about "
-                   "twice the time), rigid (a rigid tube)")
+                   "the stretch averaged over +-1 D0: closer to the FEM at a crossing, 1.7 to "
+                   "2.6 times the time), rigid (a rigid tube)")
     p.add_argument("--color-by", default=None, metavar="FIELD",
                    choices=list(COLOR_FIELDS) + list(COLOR_ALIASES),
                    help=f"colour of the rod tube in the .rrd: {', '.join(COLOR_FIELDS)} "

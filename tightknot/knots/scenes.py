@@ -33,9 +33,10 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   averaged over +-:data:`SMOOTHED_RADIUS_WINDOW` D0 along the rod
   (:mod:`tightknot.rods.section_radius`): the indent force within -8 to +7 % of the
   fine-mesh FEM, its axial force at the crossing 1.07 times the FEM's; the knots come out
-  the same within 1e-4 (closed trefoil at 16.37: stretch) to 0.3 % (open knots: pulling
-  force), at about 3 times the time per Newton iteration (its Hessian couples whole
-  windows of the rod). Not in the batch (:func:`tightknot.knots.batch.tie_batch`).
+  the same within 1e-4 (closed trefoil at 16.37: stretch) to 3 % (the 185 mm knot's pulling
+  force, reached at another Lambda_OC within its tolerance), in as many Newton iterations
+  at 1.7 to 2.6 times the time (its Hessian couples whole windows of the rod;
+  bench/contact_levels.py). Not in the batch (:func:`tightknot.knots.batch.tie_batch`).
   ``contact="rigid"``: the same layer with ``law.rigid_tube()``, 1000 times stiffer and a
   hard radius D0/2 that does not thin with stretch; neglects every deformation of the
   section (the ideal-knot tube); width, pressure and area are then not reported.

@@ -1,0 +1,82 @@
+"""The study's three knots at the contact levels ``compliant`` and ``smoothed``: Newton
+iterations, wall time and the knots' measures, in one run (compare ratios, not seconds:
+the machines are shared).
+
+Usage: ``python bench/contact_levels.py [--closed-nodes 100] [--open-nodes 150]
+[--levels compliant smoothed] [--json out.json]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from tightknot.atomic import write_json_atomic
+from tightknot.knots.scenes import closed_trefoil, open_trefoil, vertex_radii
+from tightknot.knots.tie import lambda_oc, tie, tie_to_lambda
+
+#: (name, rest length [m], target Lambda_OC) of the study's open knots (physics.md sec. 1).
+OPEN_CASES = (("open_125mm_to_10.1", 0.125, 10.1), ("open_185mm_to_15", 0.185, 15.0))
+
+
+def closed_case(level: str, nodes: int) -> dict:
+    """The closed trefoil at L0/D0 = 16.37."""
+    scene = closed_trefoil(16.37, nodes=nodes, contact=level)
+    t0 = time.perf_counter()
+    res = tie(scene)
+    wall = time.perf_counter() - t0
+    x = res.system.state.x
+    length = float(np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1).sum())
+    return {"case": "closed_16.37", "level": level, "vertices": nodes,
+            "converged": res.converged, "failure": res.failure,
+            "knot_types": sorted(set(res.knot_types)), "newton_iterations": res.newton_iterations,
+            "wall_time_s": wall, "stretch": length / scene.rest_length}
+
+
+def open_case(level: str, nodes: int, name: str, length: float, target: float) -> dict:
+    """An open trefoil of rest ``length`` [m] pulled to Lambda_OC ``target``."""
+    scene = open_trefoil(length, nodes=nodes, contact=level)
+    t0 = time.perf_counter()
+    res = tie_to_lambda(scene, target)
+    wall = time.perf_counter() - t0
+    x = res.system.state.x
+    lam = lambda_oc(x, scene.diameter, vertex_radii(scene, x, res.system.rest)[1])
+    return {"case": name, "level": level, "vertices": nodes, "converged": res.converged,
+            "failure": res.failure, "knot_types": sorted(set(res.knot_types)),
+            "newton_iterations": res.newton_iterations, "wall_time_s": wall,
+            "lambda_oc": lam, "pull_force_N": res.pull_force_N}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--closed-nodes", type=int, default=100)
+    parser.add_argument("--open-nodes", type=int, default=150)
+    parser.add_argument("--levels", nargs="+", default=["compliant", "smoothed"],
+                        choices=["compliant", "smoothed", "rigid"])
+    parser.add_argument("--json", default=None)
+    args = parser.parse_args()
+    tie(closed_trefoil(nodes=40), tighten_steps=5)  # compile the kernels outside the timing
+    rows = []
+    for level in args.levels:
+        rows.append(closed_case(level, args.closed_nodes))
+        print(json.dumps(rows[-1]))
+        for name, length, target in OPEN_CASES:
+            rows.append(open_case(level, args.open_nodes, name, length, target))
+            print(json.dumps(rows[-1]))
+    base = {r["case"]: r for r in rows if r["level"] == args.levels[0]}
+    ratios = [{"case": r["case"], "level": r["level"],
+               "time_ratio_to_" + args.levels[0]: r["wall_time_s"] / base[r["case"]]["wall_time_s"],
+               "iteration_ratio_to_" + args.levels[0]:
+                   r["newton_iterations"] / base[r["case"]]["newton_iterations"]}
+              for r in rows if r["level"] != args.levels[0]]
+    for r in ratios:
+        print(json.dumps(r))
+    if args.json:
+        write_json_atomic(args.json, {"rows": rows, "ratios": ratios})
+
+
+if __name__ == "__main__":
+    main()
