@@ -162,8 +162,7 @@ def _solve_levels(system: Any, path: _Path, levels: list[float],
     return rows
 
 
-def _section_stretch(layer: Any, x: np.ndarray, model: Any, rod_v: np.ndarray, mid: int,
-                     own: float) -> float:
+def _section_stretch(layer: Any, x: np.ndarray, model: Any, mid: int, own: float) -> float:
     """The stretch that thins the rod's mid section: ``own`` (the mid edges' mean) or, with a
     radius window, the layer's window mean over the two mid edges."""
     if layer.radius_window == 0.0:
@@ -248,7 +247,7 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
         dist = math.hypot(y_up - xm[1], xm[2])
         e = np.linalg.norm(np.diff(x[rod_v], axis=0), axis=1)
         stretch = float(0.5 * (e[mid - 1] + e[mid]) / (2.0 * half / n_rod))
-        sec = _section_stretch(layer, x, model, rod_v, mid, stretch)
+        sec = _section_stretch(layer, x, model, mid, stretch)
         overlap = d0 / 2.0 * sec**-0.5 + d0 / 2.0 - dist
         w_side = max(overlap, 0.0)  # rigid indenter: the rod takes the whole overlap
         return {
@@ -335,7 +334,7 @@ def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
         voronoi = 0.5 * (e[mid - 1] + e[mid])
         f_mid = float(np.linalg.norm(g[rod_v[mid]])) / voronoi
         stretch = float(voronoi / (2.0 * half / n_rod))
-        sec = _section_stretch(layer, x, model, rod_v, mid, stretch)
+        sec = _section_stretch(layer, x, model, mid, stretch)
         xm = xr[mid]
         dist = math.hypot(y_obs - xm[1], xm[2])
         overlap = d0 / 2.0 * sec**-0.5 + d0 / 2.0 - dist
