@@ -32,7 +32,8 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   ``contact="smoothed"``: the compliant law with the section thinned by the stretch
   averaged over +-:data:`SMOOTHED_RADIUS_WINDOW` D0 along the rod
   (:mod:`tightknot.rods.section_radius`): the indent force within -8 to +7 % of the
-  fine-mesh FEM, its axial force at the crossing 1.07 times the FEM's; the knots come out
+  fine-mesh FEM, its axial force at the crossing 1.07 (deepest level) to 5 times the FEM's
+  (compliant: 3.4 to 54 times); the knots come out
   the same within 1e-4 (closed trefoil at 16.37: stretch) to 3 % (the 185 mm knot's pulling
   force, reached at another Lambda_OC within its tolerance), in as many Newton iterations
   at 1.7 to 2.6 times the time (its Hessian couples whole windows of the rod;
@@ -78,7 +79,7 @@ _CUT_OFFSET = 0.6
 CONTACT_LEVELS = ("compliant", "smoothed", "rigid", "off")
 
 #: Half-width [D0] of the stretch window of the "smoothed" contact level: 1 D0 gives the
-#: FEM's axial force at the indent's crossing (1.07 times it; 0.5 D0: 2 times), see
+#: FEM's axial force at the indent's deepest level (1.07 times it; 0.5 D0: 2 times), see
 #: docs/fem_crosscheck.md.
 SMOOTHED_RADIUS_WINDOW = 1.0
 

@@ -125,7 +125,7 @@ class ContactLayer:
             that thins the contact radius is averaged (:mod:`tightknot.rods.section_radius`);
             0 (default): each edge's own stretch. At 1 D0 the FEM cross-check's indent force
             is within -8 to +7 % of the fine-mesh FEM (-15 to +4 % with 0) and the axial
-            force at the crossing 1.07 times the FEM's (3.4 times with 0), and the study's
+            force at the deepest crossing 1.07 times the FEM's (3.4 times with 0), and the study's
             knots tie in about as many Newton iterations; each iteration costs more (the
             Hessian couples whole windows; docs/fem_crosscheck.md). Not with a rigid-tube
             law (its radius does not thin), not in the batch (:mod:`tightknot.knots.batch`).

@@ -3,7 +3,7 @@
 The contact layer thins each section with stretch, r = r0 lambda^-nu (incompressible:
 nu = 1/2). With each edge's own stretch (``radius_window = 0``, the default) the contact
 energy of a crossing lowers when the edges under it stretch, so the contact pulls them
-apart: at the FEM cross-check's indent the rod carries 3 to 30 times the FEM's axial force
+apart: at the FEM cross-check's indent the rod carries 3.4 to 54 times the FEM's axial force
 at the crossing and its force is 11 to 16 % short (docs/fem_crosscheck.md). A section of a
 solid does not thin with one edge but with the material around it. Here the stretch that
 thins the section is the mean over the edges within +-``window`` D0 along the rod (a box
