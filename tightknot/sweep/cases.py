@@ -15,7 +15,8 @@ Parameters (SI units):
 * ``diameter`` D0 [m] (8.5e-3), ``youngs_modulus`` E [Pa] (1.25e6), ``poisson`` nu
   (0.5, in (-1, 0.5]), ``density`` [kg/m^3] (1160; only the proximal fallback uses it).
 * ``contact``: "compliant" (the FEM-calibrated radial-compliance law), "smoothed" (the
-  same law, the section thinned by the stretch averaged over +-1 D0; not with ``--batch``)
+  same law, the section thinned by the stretch averaged over +-1 D0; a sweep with
+  ``--batch`` ties these cases one by one)
   or "rigid" (the rigid-tube law, 1e3 times stiffer, radius not thinned by stretch).
 * ``twist``: twist dofs on or off (default on for closed, off for open knots: an isotropic
   rod with twist-free ends relaxes its twist to zero).
