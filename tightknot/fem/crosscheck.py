@@ -269,6 +269,20 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "vertices": int(model.vertex_count), "law": pair_law.source}
 
 
+def wrap_constraints(bcs: Any, n_rod: int, theta: float, path: _Path) -> int:
+    """The wrapped rod's (rod 0, ``n_rod`` edges) constraints of the wrap scene: the plane
+    x = 0, the symmetry plane z = 0 at its middle vertex, and dead end forces
+    ``path(t)`` (0, sin(theta), +-cos(theta)) [N]. Returns the middle vertex."""
+    mid = n_rod // 2
+    for k in range(n_rod + 1):
+        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
+    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
+    s, c = math.sin(theta), math.cos(theta)
+    bcs.force(0, 0, lambda t: path(t) * np.array([0.0, s, -c]))
+    bcs.force(0, -1, lambda t: path(t) * np.array([0.0, s, c]))
+    return mid
+
+
 def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
              diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
              length_over_d0: float = 4.5, law: Any = None,
@@ -312,13 +326,7 @@ def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     bcs = BoundaryConditions(model)
     for k in range(n_obs + 1):
         bcs.pin(1, k)
-    mid = n_rod // 2
-    for k in range(n_rod + 1):
-        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
-    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
-    s, c = math.sin(theta), math.cos(theta)
-    bcs.force(0, 0, lambda t: path(t) * np.array([0.0, s, -c]))
-    bcs.force(0, -1, lambda t: path(t) * np.array([0.0, s, c]))
+    mid = wrap_constraints(bcs, n_rod, theta, path)
     system = RodSystem(model, State.initial(model), bcs)
     layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window)
     system.add_term(layer)
@@ -424,16 +432,32 @@ def _wrap_centroid_axis(fem_steps: list[dict], rod_steps: list[dict]) -> list[di
     return rows
 
 
-def _indent_diagnostics(fem: dict[str, Any], rod: dict[str, Any], length_over_d0: float
-                        ) -> dict[str, Any]:
+def _rod_indent_like(fem: dict[str, Any], run: Any = None, **kw: Any) -> dict[str, Any]:
+    """``run`` (default :func:`rod_indent`) at the load levels, diameter, modulus and segment
+    length of the FEM indent result ``fem``; ``kw`` go to ``run``."""
+    par = fem["parameters"]
+    d0 = par["diameter_m"]
+    return (run or rod_indent)([s["w_over_d0"] * d0 for s in fem["steps"]], diameter=d0,
+                               youngs_modulus=par["youngs_modulus_pa"],
+                               length_over_d0=par["segment_length_m"] / d0, **kw)
+
+
+def _rod_wrap_like(fem: dict[str, Any], run: Any = None, **kw: Any) -> dict[str, Any]:
+    """``run`` (default :func:`rod_wrap`) at the tensions, wrap angle, diameter, modulus
+    and segment length of the FEM wrap result ``fem``; ``kw`` go to ``run``."""
+    par = fem["parameters"]
+    return (run or rod_wrap)([s["tension"] for s in fem["steps"]],
+                             wrap_angle_deg=par["wrap_angle_deg"], diameter=par["diameter_m"],
+                             youngs_modulus=par["youngs_modulus_pa"],
+                             length_over_d0=par["segment_length_m"] / par["diameter_m"], **kw)
+
+
+def _indent_diagnostics(fem: dict[str, Any], rod: dict[str, Any]) -> dict[str, Any]:
     """Why the rod model's indent force falls short (not timed, not part of ``passed``):
     the axial force that the contact layer puts into the rod at the crossing, against the
     FEM's, and the rod model rerun with nu = 0 (its contact radius r0 lambda^(-nu) then
     does not thin with stretch, so the contact energy has no derivative along the rod)."""
-    d0 = fem["parameters"]["diameter_m"]
-    rest = rod_indent([s["w_over_d0"] * d0 for s in fem["steps"]], diameter=d0,
-                      youngs_modulus=fem["parameters"]["youngs_modulus_pa"],
-                      length_over_d0=length_over_d0, poisson_ratio=0.0)
+    rest = _rod_indent_like(fem, poisson_ratio=0.0)
     rows = []
     for f, r, b in zip(fem["steps"], rod["steps"], rest["steps"], strict=True):
         if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9:
@@ -498,14 +522,9 @@ def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
     """The wrap with kernel variants (:mod:`tightknot.fem.wrap_variants`) against the FEM."""
     from .wrap_variants import rod_wrap_variant
 
-    wp_ = fem_wrap["parameters"]
     out = []
     for kernel, footprint in WRAP_VARIANTS:
-        res = rod_wrap_variant([s["tension"] for s in fem_wrap["steps"]], kernel=kernel,
-                               footprint=footprint, wrap_angle_deg=wp_["wrap_angle_deg"],
-                               diameter=wp_["diameter_m"],
-                               youngs_modulus=wp_["youngs_modulus_pa"],
-                               length_over_d0=wp_["segment_length_m"] / wp_["diameter_m"])
+        res = _rod_wrap_like(fem_wrap, rod_wrap_variant, kernel=kernel, footprint=footprint)
         levels = []
         for f, r in zip(fem_wrap["steps"], res["steps"], strict=True):
             if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9:
@@ -536,17 +555,8 @@ def _smoothed_level(fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
     the report is the default level's)."""
     from tightknot.knots.scenes import SMOOTHED_RADIUS_WINDOW as window
 
-    d0 = fem_ind["parameters"]["diameter_m"]
-    ind = rod_indent([s["w_over_d0"] * d0 for s in fem_ind["steps"]], diameter=d0,
-                     youngs_modulus=fem_ind["parameters"]["youngs_modulus_pa"],
-                     length_over_d0=fem_ind["parameters"]["segment_length_m"] / d0,
-                     radius_window=window)
-    wp_ = fem_wrap["parameters"]
-    wr = rod_wrap([s["tension"] for s in fem_wrap["steps"]],
-                  wrap_angle_deg=wp_["wrap_angle_deg"], diameter=wp_["diameter_m"],
-                  youngs_modulus=wp_["youngs_modulus_pa"],
-                  length_over_d0=wp_["segment_length_m"] / wp_["diameter_m"],
-                  radius_window=window)
+    ind = _rod_indent_like(fem_ind, radius_window=window)
+    wr = _rod_wrap_like(fem_wrap, radius_window=window)
     comp = {
         "indent": _compare(fem_ind["steps"], ind["steps"], ("force", "force"), None),
         "wrap": _compare(fem_wrap["steps"], wr["steps"],
@@ -604,17 +614,10 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         fem_results["wrap"] = run_scene("wrap", mesh=mesh, convergence=False)
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
     warm = _warm_up()
-    d0 = fem_ind["parameters"]["diameter_m"]
-    rod_ind = rod_indent([s["w_over_d0"] * d0 for s in fem_ind["steps"]],
-                         diameter=d0, youngs_modulus=fem_ind["parameters"]["youngs_modulus_pa"],
-                         length_over_d0=fem_ind["parameters"]["segment_length_m"] / d0)
+    rod_ind = _rod_indent_like(fem_ind)
+    rod_wr = _rod_wrap_like(fem_wrap)
     wp_ = fem_wrap["parameters"]
-    rod_wr = rod_wrap([s["tension"] for s in fem_wrap["steps"]],
-                      wrap_angle_deg=wp_["wrap_angle_deg"], diameter=wp_["diameter_m"],
-                      youngs_modulus=wp_["youngs_modulus_pa"],
-                      length_over_d0=wp_["segment_length_m"] / wp_["diameter_m"])
-    ind_len = fem_ind["parameters"]["segment_length_m"] / d0
-    diagnostics = _indent_diagnostics(fem_ind, rod_ind, ind_len)
+    diagnostics = _indent_diagnostics(fem_ind, rod_ind)
     diagnostics["indent_footprint"] = _indent_footprint(fem_ind, rod_ind)
     diagnostics["wrap_kernel_variants"] = _wrap_variants(fem_wrap)
     smoothed = _smoothed_level(fem_ind, fem_wrap, rod_ind, rod_wr)

@@ -192,7 +192,14 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
     from tightknot.rods.state import State
     from tightknot.solvers.system import RodSystem
 
-    from .crosscheck import DENSITY, EDGES_PER_D0, _Path, _solve_levels, rigid_counterbody_law
+    from .crosscheck import (
+        DENSITY,
+        EDGES_PER_D0,
+        _Path,
+        _solve_levels,
+        rigid_counterbody_law,
+        wrap_constraints,
+    )
 
     start = time.perf_counter()
     pair_law = rigid_counterbody_law(law or RadialComplianceLaw.from_json())
@@ -208,13 +215,7 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
     model = b.finalize()
     path = _Path()
     bcs = BoundaryConditions(model)
-    mid = n_rod // 2
-    for k in range(n_rod + 1):
-        bcs.fix_components(0, k, (0,))  # the plane x = 0
-    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
-    s, c = math.sin(theta), math.cos(theta)
-    bcs.force(0, 0, lambda t: path(t) * np.array([0.0, s, -c]))
-    bcs.force(0, -1, lambda t: path(t) * np.array([0.0, s, c]))
+    mid = wrap_constraints(bcs, n_rod, theta, path)
     system = RodSystem(model, State.initial(model), bcs)
     term = ObstacleLineContact(model, pair_law, y_axis, kernel, footprint, youngs_modulus, d0)
     system.add_term(term)
@@ -240,7 +241,7 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
             "kappa_d0_mid": float(bergou_curvature(x, closed=False)[mid]) * d0,
             "contact_half_length_over_d0": float(np.abs(arc[loaded]).max()) / d0,
             "contact_force_total_over_2t_sin_theta":
-                float(np.linalg.norm(g.sum(axis=0))) / (2.0 * tension * s),
+                float(np.linalg.norm(g.sum(axis=0))) / (2.0 * tension * math.sin(theta)),
         }
 
     rows = _solve_levels(system, path, list(tension_levels), measure)

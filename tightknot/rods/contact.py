@@ -378,8 +378,7 @@ class ContactLayer:
         m = self.model
         geo = self._geometry(x, rest)
         pairs, e_pair, grad, hess, overlap, _ = self._launch(
-            x, rest, want_grad or (geo is not None and want_hess), int(want_hess),
-            radius=self._radius_array(geo))
+            x, rest, want_grad, int(want_hess), radius=self._radius_array(geo))
         self._remember(pairs, overlap)
         if pairs.shape[0] == 0:
             empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
@@ -391,13 +390,9 @@ class ContactLayer:
         if want_hess:
             # Only pairs that interact carry a Hessian (most candidates do not).
             active = np.flatnonzero(e_pair != 0.0)
-            pr = self.last_pairs[active]
             npairs = active.size
             hvals = hess.numpy().reshape(-1, 144)[active].ravel()
-            ev = m.edge_vertex.astype(np.int64)
-            verts = np.concatenate([ev[pr[:, 0]], ev[pr[:, 1]]], axis=1)  # (P, 4)
-            dofs = (m.vertex_dof.astype(np.int64)[verts][:, :, None] + np.arange(3)).reshape(
-                -1, 12)
+            dofs = self._pair_dofs(self.last_pairs[active])
             rows = np.broadcast_to(dofs[:, :, None], (npairs, 12, 12)).ravel()
             cols = np.broadcast_to(dofs[:, None, :], (npairs, 12, 12)).ravel()
             coo = (rows, cols, hvals)
@@ -445,17 +440,21 @@ class ContactLayer:
     def _smoothed_terms(self, geo: dict[str, np.ndarray], e_pair: np.ndarray,
                         want_hess: bool) -> tuple[np.ndarray, tuple | None]:
         """The smoothed radius's gradient term (V, 3) [N] and Hessian COO (or None)."""
-        m = self.model
         active = np.flatnonzero(e_pair != 0.0)
         pr = self.last_pairs[active]
         d_r = self._dR.numpy(14 * e_pair.size).reshape(-1, 14)[active]
         g, big_g, c = self._smooth.gradient(geo, pr, d_r[:, 0])
         if not want_hess:
             return g, None
+        return g, self._smooth.hessian(geo, pr, self._pair_dofs(pr), d_r[:, 1], d_r[:, 2:],
+                                       big_g, c)
+
+    def _pair_dofs(self, pairs: np.ndarray) -> np.ndarray:
+        """The 12 position dofs of each edge pair's vertices [a0, a1, b0, b1], (P, 12)."""
+        m = self.model
         ev = m.edge_vertex.astype(np.int64)
-        verts = np.concatenate([ev[pr[:, 0]], ev[pr[:, 1]]], axis=1)
-        dofs = (m.vertex_dof.astype(np.int64)[verts][:, :, None] + np.arange(3)).reshape(-1, 12)
-        return g, self._smooth.hessian(geo, pr, dofs, d_r[:, 1], d_r[:, 2:], big_g, c)
+        verts = np.concatenate([ev[pairs[:, 0]], ev[pairs[:, 1]]], axis=1)  # (P, 4)
+        return (m.vertex_dof.astype(np.int64)[verts][:, :, None] + np.arange(3)).reshape(-1, 12)
 
     def section_stretch(self, x: np.ndarray, rest: np.ndarray) -> np.ndarray:
         """The stretch that thins each edge's section [-]: its own, or the window mean."""
