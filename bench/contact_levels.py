@@ -15,8 +15,10 @@ import time
 import numpy as np
 
 from tightknot.atomic import write_json_atomic
+from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import closed_trefoil, open_trefoil, vertex_radii
-from tightknot.knots.tie import lambda_oc, tie, tie_to_lambda
+from tightknot.loading.pull import tie_to_lambda
+from tightknot.loading.tie import tie
 
 #: (name, rest length [m], target Lambda_OC) of the study's open knots (physics.md sec. 1).
 OPEN_CASES = (("open_125mm_to_10.1", 0.125, 10.1), ("open_185mm_to_15", 0.185, 15.0))

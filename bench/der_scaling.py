@@ -5,7 +5,7 @@ Usage: python bench/der_scaling.py [--json FILE] (same as ``tightknot bench der`
 
 import sys
 
-from tightknot.cli import main
+from tightknot.app.cli import main
 
 if __name__ == "__main__":
     sys.exit(main(["bench", "der", *sys.argv[1:]]))

@@ -41,7 +41,7 @@ def _cases(quick: bool, huge: bool) -> list[tuple[str, Callable[[], C.Outcome]]]
 
     def f32() -> C.Outcome:
         from tightknot.knots.scenes import closed_trefoil
-        from tightknot.knots.tie import tie
+        from tightknot.loading.tie import tie
 
         start = time.perf_counter()
         scene = closed_trefoil(16.37, C.D0, 64)

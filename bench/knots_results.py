@@ -1,7 +1,7 @@
 """Results of the knots issue's closing note: the study's three knots, measured.
 
 Ties the closed trefoil (L0/D0 = 16.37) and the two open trefoils (185 mm pulled to
-Lambda_OC = 15.0, 125 mm to 10.1) with :func:`tightknot.knots.run.run_knot` (the demo's and
+Lambda_OC = 15.0, 125 mm to 10.1) with :func:`tightknot.study.run.run_knot` (the demo's and
 the golden runs' path), measures them with :func:`tightknot.knots.measure.analyze_centerline`
 and the contact layer's report, writes JSON and prints a markdown table.
 
@@ -32,8 +32,8 @@ import numpy as np
 from tightknot.atomic import write_json_atomic
 from tightknot.knots.ideal import load_ideal_trefoil
 from tightknot.knots.measure import analyze_centerline
-from tightknot.knots.run import KnotRun, draw_figures, run_knot
 from tightknot.knots.scenes import closed_trefoil, open_trefoil
+from tightknot.study.run import KnotRun, draw_figures, run_knot
 
 
 def _stats(k: np.ndarray) -> dict[str, float]:

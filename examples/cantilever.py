@@ -9,7 +9,7 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment
 from tightknot.rods.state import State
-from tightknot.solvers.static import ContinuationOptions, solve_static
+from tightknot.solvers.continuation import ContinuationOptions, solve_static
 from tightknot.solvers.system import RodSystem
 from tightknot.verification.elastica import cantilever_tip
 

@@ -5,8 +5,8 @@ Run: python examples/closed_trefoil.py [out.rrd]
 
 import sys
 
-from tightknot.knots.run import run_knot
 from tightknot.knots.scenes import closed_trefoil
+from tightknot.study.run import run_knot
 from tightknot.viz.rerun_log import make_logger
 
 

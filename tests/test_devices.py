@@ -73,7 +73,7 @@ def _invariants(x: np.ndarray, scene) -> tuple[float, float, float]:
 
 def test_a_closed_knot_ties_to_the_same_equilibrium() -> None:
     from tightknot.knots.scenes import closed_trefoil
-    from tightknot.knots.tie import tie
+    from tightknot.loading.tie import tie
 
     runs = {}
     for dev in ("cpu", CUDA):
@@ -86,9 +86,9 @@ def test_a_closed_knot_ties_to_the_same_equilibrium() -> None:
 
 
 def test_a_batch_on_the_gpu_agrees_with_one_by_one_on_the_cpu() -> None:
-    from tightknot.knots.batch import tie_batch
     from tightknot.knots.scenes import closed_trefoil
-    from tightknot.knots.tie import tie
+    from tightknot.loading.batch import tie_batch
+    from tightknot.loading.tie import tie
 
     ratios = (17.0, 18.5)
     batch = tie_batch([closed_trefoil(l0_over_d0=r, nodes=60, device=CUDA) for r in ratios],

@@ -1,4 +1,5 @@
-"""Atomic file output: write to a temporary file in the target folder, then rename.
+"""Output files: checked before a run, written atomically (a temporary file in the target
+folder, then a rename).
 
 A run killed at any moment leaves either the previous complete file or the new
 complete file, never a half-written one (``os.replace`` is atomic on POSIX when the
@@ -56,3 +57,15 @@ def write_json_atomic(path: str | os.PathLike[str], obj: Any, indent: int = 2) -
     """Write ``obj`` as JSON to ``path`` atomically (NaN is refused, not written)."""
     text = json.dumps(obj, indent=indent, allow_nan=False)
     write_text_atomic(path, text + "\n")
+
+
+def writable_file(path: str | None) -> Path | None:
+    """Check before the run that an output file's folder exists (fail early, not after minutes)."""
+    if path is None:
+        return None
+    p = Path(path)
+    if not p.parent.exists() and str(p.parent) not in ("", "."):
+        raise ValueError(f"output folder does not exist: {p.parent}")
+    if p.is_dir():
+        raise ValueError(f"output path is a folder, not a file: {p}")
+    return p

@@ -17,7 +17,7 @@ echo "$(cat .whl/wheel.sha256)  /tmp/$name" | sha256sum -c - >> "$OUT/run.log" 2
 python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --target /tmp/site \
     "/tmp/$name" >> "$OUT/run.log" 2>&1 || { log "pip install of $name failed"; exit 4; }
 export PYTHONPATH=/tmp/site:$PWD WARP_CACHE_PATH=/tmp/warp-cache
-TK=(python3 -c 'import sys; from tightknot.cli import main; sys.exit(main(sys.argv[1:]))')
+TK=(python3 -c 'import sys; from tightknot.app.cli import main; sys.exit(main(sys.argv[1:]))')
 nvidia-smi >> "$OUT/run.log" 2>&1
 log "warp devices: $(python3 -c 'import warp as wp; wp.init(); print([d.alias for d in wp.get_devices()])' 2>&1 | tail -1)"
 log "pytest -m cuda"

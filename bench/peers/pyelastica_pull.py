@@ -9,7 +9,7 @@ Scene arrays: ``start`` (N, 3) [m] start centerline (tightknot's loose open tref
 resampled to this run's node count), ``rest_length`` L0 [m], ``diameter`` D0 [m],
 ``youngs_modulus`` [Pa], ``poisson_ratio``, ``density`` [kg/m^3], ``end_distance`` X [m].
 
-The load path is tightknot's (tightknot.knots.tie), run as a damped dynamic simulation:
+The load path is tightknot's (tightknot.loading.tie), run as a damped dynamic simulation:
 1. ``T1`` seconds: the rest length shrinks from the start length to L0 (rest lengths,
    rest Voronoi lengths and element volumes scaled together, so the rest radius stays D0/2
    and the radius follows volume conservation, r = r0 / sqrt(stretch), as in tightknot); the

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
+from tightknot.app.cli import main
 from tightknot.benchmarks import batch, scaling, tradeoff
-from tightknot.cli import main
 
 
 def _finite(v) -> bool:  # noqa: ANN001
@@ -21,7 +21,7 @@ def test_batch_bench_tiny(tmp_path):
     for key in ("rods", "batched_s", "sequential_s", "speedup"):
         assert _finite(r[key]), key
     assert r["rods"] == 2 and r["sequential_extrapolated"] is False
-    assert _finite(r["max_position_diff_over_D0"])  # agreement: tests/knots/test_batch.py
+    assert _finite(r["max_position_diff_over_D0"])  # agreement: tests/loading/test_batch.py
     assert r["speedup"] == pytest.approx(r["sequential_s"] / r["batched_s"])
 
 

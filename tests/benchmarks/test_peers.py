@@ -11,8 +11,8 @@ import sys
 import numpy as np
 import pytest
 
+from tightknot.app.cli import main
 from tightknot.benchmarks import peers
-from tightknot.cli import main
 
 
 def test_profile_rms_diff_of_a_constant_offset_is_the_offset() -> None:

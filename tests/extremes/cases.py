@@ -18,8 +18,9 @@ from typing import Any
 
 import numpy as np
 
+from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import KnotScene, closed_trefoil, open_trefoil, vertex_radii
-from tightknot.knots.tie import TieResult, knot_type_of, lambda_oc, tie
+from tightknot.loading.tie import TieResult, knot_type_of, tie
 from tightknot.rods.material import Material
 
 #: The study's rod (physics.md sec. 1).
@@ -152,7 +153,7 @@ def knot_limits(scene: KnotScene, res: TieResult) -> dict[str, float | None]:
 def run_tie_case(name: str, make_scene: Callable[[], KnotScene], summary: bool = True,
                  **tie_kw: Any) -> Outcome:
     """Build a scene and tie it; ValueError from either is a rejection. With ``summary``
-    the run's JSON summary (tightknot.knots.run.run_knot) is made and checked for NaN too."""
+    the run's JSON summary (tightknot.study.run.run_knot) is made and checked for NaN too."""
     start = time.perf_counter()
     try:
         scene = make_scene()
@@ -160,7 +161,7 @@ def run_tie_case(name: str, make_scene: Callable[[], KnotScene], summary: bool =
         return Outcome(name, "rejected", str(err), time.perf_counter() - start)
     try:
         if summary:
-            from tightknot.knots.run import run_knot
+            from tightknot.study.run import run_knot
 
             run = run_knot(scene, **tie_kw)
             res, outputs = run.result, run.summary

@@ -135,7 +135,7 @@ def test_scale_invariance_steel_equals_rubber(rubber: C.Outcome) -> None:
 def test_cli_tie_steel_gives_the_rubber_shape(tmp_path, rubber: C.Outcome) -> None:
     # The command, at 48 vertices: same L/D and curvature as rubber (tied through
     # the API with the CLI's load steps, 40).
-    from tightknot.cli import main
+    from tightknot.app.cli import main
 
     out = tmp_path / "steel.json"
     code = main(["tie", "closed", "--youngs-modulus", "2e11", "--nodes", "48", "--quiet",
@@ -248,7 +248,7 @@ def test_float32_positions_cannot_hold_the_tolerance() -> None:
     # What float32 would break: the tied knot's equilibrium, rounded to float32, has a
     # scaled residual far above the solver's 1e-6 (a float32 Newton could not converge).
     from tightknot.knots.scenes import closed_trefoil
-    from tightknot.knots.tie import tie
+    from tightknot.loading.tie import tie
 
     scene = closed_trefoil(16.37, C.D0, 64)
     res = tie(scene, tighten_steps=40)
@@ -264,7 +264,7 @@ def test_failed_cli_run_writes_its_summary_and_exits_1(tmp_path) -> None:
     # A relaxation budget of 3 Newton iterations cannot relax the start: the physics fails
     # (exit 1), and the JSON summary is still written, NaN-free, with converged false and
     # the reason.
-    from tightknot.cli import main
+    from tightknot.app.cli import main
 
     out = tmp_path / "s.json"
     code = main(["tie", "closed", "--nodes", "48", "--relax-iterations", "3", "--quiet",

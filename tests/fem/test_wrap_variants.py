@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from tightknot.fem.crosscheck import rigid_counterbody_law, rod_wrap
+from tightknot.contact.law import RadialComplianceLaw
 from tightknot.fem.material import ROD_DIAMETER as D0
 from tightknot.fem.material import YOUNGS_MODULUS as E
+from tightknot.fem.rod_model import rigid_counterbody_law, rod_wrap
 from tightknot.fem.wrap_variants import ObstacleLineContact, rod_wrap_variant
-from tightknot.rods.contact_law import RadialComplianceLaw
 
 LEVELS = [0.25 * (k / 6) ** 2 * E * D0**2 for k in (1, 3, 5)]
 

@@ -82,7 +82,7 @@ def test_missing_file_is_a_clean_error(tmp_path) -> None:
 def test_analyze_command_exits_0_or_2(tmp_path_factory, pts, diameter: str, mode) -> None:
     # The whole command on random polygons: a result (0) or bad input (2), the only exits
     # it defines for analyze; an exception escaping main() would fail here.
-    from tightknot.cli import main
+    from tightknot.app.cli import main
 
     folder = tmp_path_factory.mktemp("a")
     f = folder / "c.csv"

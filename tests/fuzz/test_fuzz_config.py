@@ -1,4 +1,4 @@
-"""Bad input to the run-config loader (tightknot/config.py, issue 8): any mapping or any
+"""Bad input to the run-config loader (tightknot/app/config.py, issue 8): any mapping or any
 file gives a TieConfig within the documented ranges or a ValueError naming the key (or the
 file); nothing else escapes."""
 
@@ -10,7 +10,7 @@ import math
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tightknot.config import TieConfig, config_from_dict, config_keys, load_config
+from tightknot.app.config import TieConfig, config_from_dict, config_keys, load_config
 
 KEYS = config_keys()
 value = st.one_of(st.none(), st.booleans(), st.integers(-10**7, 10**7),

@@ -4,7 +4,9 @@ contact) a scene declares (issues 5 and 7; tightknot/knots/scenes.py docstring).
 import numpy as np
 import pytest
 
+from tightknot.contact.law import RadialComplianceLaw
 from tightknot.knots.measure import analyze_centerline
+from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import (
     IDEAL_L_OVER_D,
     closed_figure_eight,
@@ -13,8 +15,7 @@ from tightknot.knots.scenes import (
     open_trefoil,
     vertex_radii,
 )
-from tightknot.knots.tie import lambda_oc, tie
-from tightknot.rods.contact_law import RadialComplianceLaw
+from tightknot.loading.tie import tie
 
 
 def _length(x: np.ndarray, closed: bool) -> float:
@@ -169,7 +170,7 @@ def test_smoothed_level_ties_the_same_closed_trefoil() -> None:
 
 
 def test_smoothed_level_refusals() -> None:
-    from tightknot.knots.batch import tie_batch
+    from tightknot.loading.batch import tie_batch
     from tightknot.sweep.execute import batch_key
 
     with pytest.raises(ValueError, match="rigid-tube law"):

@@ -47,7 +47,7 @@ from tightknot.rods.elastic import ElasticForces
 from tightknot.rods.material import Material
 from tightknot.rods.model import Model
 from tightknot.rods.state import State
-from tightknot.solvers.linear import SparsePattern
+from tightknot.solvers.pattern import SparsePattern
 from tightknot.solvers.system import RodSystem
 
 # Relative step: h = STEP x the shortest edge for positions, STEP rad for twist angles. The

@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from tests.rods.test_contact import D, two_rods
+from tests.contact.test_contact import D, two_rods
+from tightknot.contact.layer import ContactLayer
 from tightknot.rods import elastic_kernels as ek
-from tightknot.rods.contact import ContactLayer
 from tightknot.rods.staging import Launches, Output, Staging
 from tightknot.warp_setup import init_warp
 

@@ -9,9 +9,10 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment
 from tightknot.rods.state import State
-from tightknot.solvers.linear import SparsePattern, factorize
+from tightknot.solvers.continuation import ContinuationOptions, solve_static
+from tightknot.solvers.linear import factorize
 from tightknot.solvers.newton import NewtonOptions, newton_solve
-from tightknot.solvers.static import ContinuationOptions, solve_static
+from tightknot.solvers.pattern import SparsePattern
 from tightknot.solvers.system import RodSystem
 
 
@@ -103,7 +104,7 @@ class _Deferred:
 
 
 def test_a_question_answered_later_gives_the_same_solve() -> None:
-    from tightknot.solvers.static import continuation_gen
+    from tightknot.solvers.continuation import continuation_gen
 
     direct = _cantilever(load_parameter=1.0)
     ref = solve_static(direct, ContinuationOptions(steps=4))

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from tightknot.cli import main
+from tightknot.app.cli import main
 
 
 @pytest.mark.parametrize(("argv", "words"), [
@@ -29,7 +29,7 @@ def test_bad_input_exits_2_with_one_line(tmp_path: Path, capsys: pytest.CaptureF
 
 
 def test_every_multi_valued_option_is_an_axis() -> None:
-    from tightknot.cli import build_parser
+    from tightknot.app.cli import build_parser
     from tightknot.sweep.commands import build_cases
 
     args = build_parser().parse_args([

@@ -106,7 +106,7 @@ def test_process_pool_and_dask_give_the_serial_records(tmp_path: Path,
 
 def _close(a, b, path: str = "") -> None:
     """Records equal but for round-off: the batched rods follow their own tie's path with
-    sums in another order and banded instead of sparse LU solves (tests/knots/test_batch.py:
+    sums in another order and banded instead of sparse LU solves (tests/loading/test_batch.py:
     positions within 1e-10 D0), so measured floats agree to 1e-8 relative (absolute 1e-9
     for values near zero), and everything else exactly."""
     if isinstance(a, dict):

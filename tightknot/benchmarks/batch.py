@@ -1,8 +1,8 @@
 """Batched tying against one-after-another: ``tightknot bench batch``.
 
 The cases are a sweep of closed trefoils over L0/D0 (the small cases a sweep runs), each
-tied by :func:`tightknot.knots.tie.tie` one after another, and all together by
-:func:`tightknot.knots.batch.tie_batch` (one model; every rod runs tie()'s own solver, all
+tied by :func:`tightknot.loading.tie.tie` one after another, and all together by
+:func:`tightknot.loading.batch.tie_batch` (one model; every rod runs tie()'s own solver, all
 rods' evaluations answered by one set of launches per round). Both are timed in the same
 run, under the same BLAS setting; the batched result is checked against the sequential
 one (largest vertex difference over D0, and the curvature profile at the best shift along
@@ -21,12 +21,12 @@ import time
 import numpy as np
 
 from tightknot.benchmarks.der import newton_iteration_parts
-from tightknot.knots.batch import BatchResult, tie_batch
-from tightknot.knots.batch_eval import EvalRequest
-from tightknot.knots.batch_linear import single_blas_thread
-from tightknot.knots.batch_newton import RodProblem
 from tightknot.knots.scenes import closed_trefoil
-from tightknot.knots.tie import tie
+from tightknot.loading.batch import BatchResult, tie_batch
+from tightknot.loading.tie import tie
+from tightknot.solvers.banded import single_blas_thread
+from tightknot.solvers.batch_eval import EvalRequest
+from tightknot.solvers.lockstep import RodProblem
 from tightknot.solvers.system import RodSystem
 
 #: The issue's target: 64 trefoils of 100 vertices batched >= 5x faster than sequential.
@@ -113,7 +113,7 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
     diffs = []
     shape_diffs = []
     last = None
-    # The batch runs with one BLAS thread (tightknot.knots.batch_linear); the one-by-one
+    # The batch runs with one BLAS thread (tightknot.solvers.banded); the one-by-one
     # ties run under the same setting, so that the ratio measures the batching alone.
     with single_blas_thread():
         for k in pick:
@@ -208,10 +208,9 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
 
 
 def _command(args) -> int:  # noqa: ANN001
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     if args.nodes < 24:
         raise ValueError(f"--nodes must be >= 24, got {args.nodes}")
     from tightknot.warp_setup import resolve_device

@@ -104,10 +104,11 @@ class _Timed:
 def run(vertices: int = 300, repeats: int = 30, device: str = "cpu") -> dict:
     """Tie the tight open trefoil with ``vertices`` vertices, time the parts of the first
     Newton iteration of a 10 % higher pull, then that load step's whole solve (seconds)."""
+    from tightknot.knots.open_measures import lambda_oc
     from tightknot.knots.scenes import open_trefoil
-    from tightknot.knots.tie import lambda_oc, tie
+    from tightknot.loading.tie import tie
+    from tightknot.solvers.continuation import ContinuationOptions, solve_static
     from tightknot.solvers.linear import factorize
-    from tightknot.solvers.static import ContinuationOptions, solve_static
 
     if vertices < 60:
         raise ValueError(f"vertices must be >= 60 (a trefoil of 125 mm), got {vertices}")
@@ -201,11 +202,10 @@ def register(subparsers: Any) -> None:
 
 
 def _command(args: argparse.Namespace) -> int:
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
     from tightknot.warp_setup import resolve_device
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     if args.repeats < 1:
         raise ValueError(f"--repeats must be >= 1, got {args.repeats}")
     r = run(args.vertices, args.repeats, resolve_device(args.device))

@@ -68,7 +68,7 @@ _STARTUP = (
     "import numpy as np;"
     "from tightknot.verification.cases import neo_hookean_stretch;"
     "from tightknot.rods.builder import RodBuilder;"
-    "from tightknot.rods.contact import ContactLayer;"
+    "from tightknot.contact.layer import ContactLayer;"
     "neo_hookean_stretch();"
     "s=np.linspace(0,0.1,11); b=RodBuilder(twist=False);"
     "b.add_rod(np.c_[s,0*s,0*s],0.01); b.add_rod(np.c_[0*s+0.05,s-0.05,0*s+0.009],0.01);"
@@ -135,11 +135,10 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
 
 
 def _command(args) -> int:  # noqa: ANN001
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
     from tightknot.warp_setup import resolve_device
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     device = resolve_device(args.device)
     sizes = tuple(args.sizes) if args.sizes else DEFAULT_SIZES
     if any(n < 3 for n in sizes):

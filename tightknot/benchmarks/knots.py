@@ -18,8 +18,10 @@ from __future__ import annotations
 import time
 from typing import Any
 
+from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import closed_trefoil, open_trefoil, vertex_radii
-from tightknot.knots.tie import lambda_oc, tie, tie_to_lambda
+from tightknot.loading.pull import tie_to_lambda
+from tightknot.loading.tie import tie
 
 #: Targets [s] of the knots issue (2 CPU cores, warm kernel cache).
 TARGETS = {"closed_trefoil_200_s": 5.0, "open_trefoil_185mm_to_10.1_300_s": 10.0}
@@ -132,11 +134,10 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
 
 
 def _command(args) -> int:  # noqa: ANN001
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
     from tightknot.warp_setup import resolve_device
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     if not 24 <= args.closed_nodes <= 5000:
         raise ValueError(f"--closed-nodes must be in [24, 5000], got {args.closed_nodes}")
     if not 120 <= args.open_nodes <= 5000:

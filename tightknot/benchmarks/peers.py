@@ -83,7 +83,7 @@ def measure(x: np.ndarray, diameter: float, rest_length: float,
     (rest_length / (N - 1)): min gap, penetration, knot type, Lambda_OC, the kappa profile."""
     from tightknot.knots import curves, topology
     from tightknot.knots.curvature import bergou_curvature
-    from tightknot.knots.tie import lambda_oc
+    from tightknot.knots.open_measures import lambda_oc
 
     x = np.asarray(x, dtype=float)
     if not np.isfinite(x).all():
@@ -121,10 +121,10 @@ def profile_rms_diff(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.n
 
 def tightknot_row(vertices: int = VERTICES, end_distance: float = END_DISTANCE,
                   rest_length: float = REST_LENGTH) -> tuple[dict, np.ndarray]:
-    """Tie the scene in tightknot (:func:`tightknot.knots.tie.tie` with ``end_distance``);
+    """Tie the scene in tightknot (:func:`tightknot.loading.tie.tie` with ``end_distance``);
     the row and the final centerline [m]. Steps = Newton iterations (each a sparse solve)."""
     from tightknot.knots.scenes import open_trefoil
-    from tightknot.knots.tie import tie
+    from tightknot.loading.tie import tie
 
     w0, c0 = time.perf_counter(), time.process_time()
     scene = open_trefoil(rest_length, nodes=int(vertices))
@@ -296,10 +296,9 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
 
 
 def _command(args) -> int:  # noqa: ANN001
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     if args.vertices < 40:
         raise ValueError(f"--vertices must be >= 40 (an open trefoil's minimum), got "
                          f"{args.vertices}")

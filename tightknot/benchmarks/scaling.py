@@ -39,9 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
+from tightknot.contact.layer import ContactLayer
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
-from tightknot.rods.contact import ContactLayer
 from tightknot.rods.material import Material
 from tightknot.rods.state import State
 from tightknot.solvers.linear import factorize
@@ -279,11 +279,10 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
 
 
 def _command(args) -> int:  # noqa: ANN001
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
     from tightknot.warp_setup import resolve_device
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     sizes = tuple(args.sizes) if args.sizes else DEFAULT_SIZES
     if any(n < 16 for n in sizes):
         raise ValueError("--sizes must be >= 16 vertices each")

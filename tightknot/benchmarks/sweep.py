@@ -47,7 +47,7 @@ def run(levels: int = DEFAULT_LEVELS, nodes: int = DEFAULT_NODES,
     """Time the sweep and its tightest level alone; ``force`` sweeps pulling forces [N]
     from ``loosest`` to ``tightest`` (geometric) instead of Lambda_OC (linear);
     ``with_tie_to_lambda`` also times the knots package's own driver to the tightest
-    Lambda_OC (:func:`tightknot.knots.tie.tie_to_lambda`)."""
+    Lambda_OC (:func:`tightknot.loading.pull.tie_to_lambda`)."""
     from tightknot.sweep import Case, run_case, run_sweep
     from tightknot.sweep.executors import SerialExecutor
 
@@ -70,7 +70,7 @@ def run(levels: int = DEFAULT_LEVELS, nodes: int = DEFAULT_NODES,
     t_alone, c_alone = time.perf_counter() - t0, time.process_time() - c0
     extra: dict[str, Any] = {}
     if with_tie_to_lambda and not force:
-        from tightknot.knots.tie import tie_to_lambda
+        from tightknot.loading.pull import tie_to_lambda
         from tightknot.sweep.execute import build_scene
 
         scene = build_scene(tight.params)
@@ -143,15 +143,14 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
     p.add_argument("--force", action="store_true",
                    help="levels are pulling forces (geometric), not knot lengths")
     p.add_argument("--with-tie-to-lambda", action="store_true",
-                   help="also time tightknot.knots.tie.tie_to_lambda to the tightest level")
+                   help="also time tightknot.loading.pull.tie_to_lambda to the tightest level")
     p.set_defaults(handler=_command)
 
 
 def _command(args) -> int:  # noqa: ANN001
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     if args.force and (args.loosest is None or args.tightest is None):
         raise ValueError("--force needs --loosest F1 and --tightest F2 [N]")
     loosest = DEFAULT_LOOSEST if args.loosest is None else args.loosest

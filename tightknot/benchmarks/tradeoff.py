@@ -5,7 +5,7 @@ Two knots: the closed trefoil (L0/D0 16.37, the scene default) and the tight ope
 it to Lambda_OC 10.15 at 300 vertices; a fixed force, so that Lambda_OC is an output whose
 error means something). Each is tied at several vertex counts, model levels (compliant or
 rigid-tube contact; twist on or off, :mod:`tightknot.knots.scenes` says what each
-neglects) and two Newton tolerances (``residual_tol`` of :func:`tightknot.knots.tie.tie`).
+neglects) and two Newton tolerances (``residual_tol`` of :func:`tightknot.loading.tie.tie`).
 Every run is compared with the finest one (the full model, most vertices, tightest
 tolerance):
 
@@ -99,7 +99,7 @@ def run_case(knot: str, nodes: int, level: Level, residual_tol: float,
     """Tie one knot and measure it; the row keeps the profile for the comparison. A run
     still going after ``budget_s`` [s] is stopped at its next converged load step and
     recorded as failed, with its time (the study must end in bounded time)."""
-    from tightknot.knots.run import run_knot
+    from tightknot.study.run import run_knot
 
     t0 = time.perf_counter()
     scene = _scene(knot, nodes, level)
@@ -335,10 +335,9 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
 
 
 def _command(args) -> int:  # noqa: ANN001
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
 
-    out = _writable_file(args.json)
+    out = writable_file(args.json)
     budget = args.budget if args.budget is not None else (60.0 if args.quick else 180.0)
     if not (math.isfinite(budget) and budget > 0):
         raise ValueError(f"--budget must be finite and > 0 s, got {args.budget!r}")

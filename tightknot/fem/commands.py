@@ -1,6 +1,6 @@
 """Command-line subcommands of the FEM part: ``fem SCENE`` and ``calibrate``.
 
-The CLI owner calls :func:`register` from ``tightknot/cli.py``; each parser gets a
+The CLI owner calls :func:`register` from ``tightknot/app/cli.py``; each parser gets a
 ``handler`` default (``args.handler(args) -> int``): 0 ok, 2 bad input or FElupe missing
 (one line on stderr, with the install hint when FElupe is missing).
 """

@@ -42,6 +42,8 @@ from typing import Any
 
 import numpy as np
 
+from tightknot.rods.term import EnergyTerm
+
 from .material import ROD_DIAMETER, YOUNGS_MODULUS
 
 KERNELS = ("point", "line")
@@ -70,11 +72,10 @@ def _point_abel_table(m: float) -> Any:
     return CubicSpline(np.append(xs, 1.2), np.append(vals, 0.0))
 
 
-class ObstacleLineContact:
+class ObstacleLineContact(EnergyTerm):
     """Contact energy of a planar rod (plane x = 0, vertices ``0..n``) against a rigid
     straight cylinder along e_x through (0, ``y_axis``, 0), with the kernel variants of the
-    module docstring. Implements the rod system's extra-term protocol
-    (:class:`tightknot.solvers.system.ExtraTerm`)."""
+    module docstring: an energy term of the rod system (:class:`tightknot.rods.term.EnergyTerm`)."""
 
     name = "contact"
 
@@ -179,20 +180,20 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
                      footprint: float = 1.0, wrap_angle_deg: float = 90.0,
                      diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
                      length_over_d0: float = 4.5, law: Any = None) -> dict[str, Any]:
-    """:func:`tightknot.fem.crosscheck.rod_wrap` with the kernel variant ``kernel`` /
+    """:func:`tightknot.fem.rod_model.rod_wrap` with the kernel variant ``kernel`` /
     ``footprint`` (module docstring) against an analytic obstacle. Returns per tension
     level [N]: ``force_per_length_mid`` [N/m], ``overlap_over_d0``, ``approach_over_d0``,
     ``kappa_d0_mid``, ``contact_half_length_over_d0`` (rest arc length from the middle to
     the last loaded vertex), and the wall time."""
+    from tightknot.contact.law import RadialComplianceLaw
     from tightknot.knots.curvature import bergou_curvature
     from tightknot.rods.boundary import BoundaryConditions
     from tightknot.rods.builder import RodBuilder
-    from tightknot.rods.contact_law import RadialComplianceLaw
     from tightknot.rods.material import Material
     from tightknot.rods.state import State
     from tightknot.solvers.system import RodSystem
 
-    from .crosscheck import (
+    from .rod_model import (
         DENSITY,
         EDGES_PER_D0,
         _Path,

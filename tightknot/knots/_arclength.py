@@ -68,3 +68,23 @@ def arc_separation(
     if closed:
         d = np.minimum(d, length - d)
     return d
+
+
+def resample_uniform(points: ArrayLike, n: int, closed: bool) -> NDArray[np.float64]:
+    """Resample a polygon to ``n`` vertices equally spaced in arc length [m].
+
+    Linear interpolation along the polygon. Closed: periodic, the first vertex is kept and
+    the spacing is L/n. Open: both end points are kept and the spacing is L/(n - 1).
+    """
+    p = as_points(points)
+    if n < (3 if closed else 2):
+        raise ValueError(f"n must be at least {3 if closed else 2}, got {n}")
+    q = np.vstack([p, p[:1]]) if closed else p
+    lengths = edge_lengths(q, closed=False)
+    if np.any(lengths == 0):
+        keep = np.concatenate([[True], lengths > 0])
+        q = q[keep]
+        lengths = lengths[lengths > 0]
+    s = np.concatenate([[0.0], np.cumsum(lengths)])
+    targets = np.linspace(0.0, s[-1], n, endpoint=not closed)
+    return np.stack([np.interp(targets, s, q[:, d]) for d in range(3)], axis=1)

@@ -10,7 +10,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-from tightknot.knots._arclength import as_points, edge_lengths, total_length, vertex_arclength
+from tightknot.knots._arclength import (
+    as_points,
+    edge_lengths,
+    resample_uniform,
+    total_length,
+    vertex_arclength,
+)
 
 
 def trefoil(n: int = 400, size: float = 1.0) -> NDArray[np.float64]:
@@ -104,26 +110,6 @@ def open_figure_eight(n: int = 800, size: float = 1.0, tail: float = 6.0) -> NDA
     base = figure_eight(2000, 1.0)
     pts = _open_from_closed(base, gap=0.03, offset=0.6, tail=tail, n=n)
     return size * pts
-
-
-def resample_uniform(points: ArrayLike, n: int, closed: bool) -> NDArray[np.float64]:
-    """Resample a polygon to ``n`` vertices equally spaced in arc length [m].
-
-    Linear interpolation along the polygon. Closed: periodic, the first vertex is kept and
-    the spacing is L/n. Open: both end points are kept and the spacing is L/(n - 1).
-    """
-    p = as_points(points)
-    if n < (3 if closed else 2):
-        raise ValueError(f"n must be at least {3 if closed else 2}, got {n}")
-    q = np.vstack([p, p[:1]]) if closed else p
-    lengths = edge_lengths(q, closed=False)
-    if np.any(lengths == 0):
-        keep = np.concatenate([[True], lengths > 0])
-        q = q[keep]
-        lengths = lengths[lengths > 0]
-    s = np.concatenate([[0.0], np.cumsum(lengths)])
-    targets = np.linspace(0.0, s[-1], n, endpoint=not closed)
-    return np.stack([np.interp(targets, s, q[:, d]) for d in range(3)], axis=1)
 
 
 def resample_equal_chords(points: ArrayLike, n: int) -> NDArray[np.float64]:

@@ -36,3 +36,16 @@ def open_knot_measures(
         lam = (s2 - s1) / diameter
     return {"Lambda_OC": lam, "S1": s1, "S2": s2, "S_mid": float(mid),
             "s": (S - mid) / diameter}
+
+
+def lambda_oc(x: np.ndarray, diameter: float, radii: np.ndarray | float | None = None,
+              tol: float = 0.01) -> float:
+    """Open-knot length Lambda_OC of centerline ``x`` (physics.md sec. 2), NaN without
+    contact; contact where the distance is at most (1 + tol) times the sum of the radii
+    (default D0/2; pass the deformed radii of a simulation, as the summaries do)."""
+    from tightknot.knots.contact_map import contact_pairs
+
+    r = np.full(len(x), diameter / 2) if radii is None else radii
+    i, j = contact_pairs(x, False, r, tol=tol)
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
+    return float(open_knot_measures(np.unique(np.r_[i, j]), s, diameter)["Lambda_OC"])

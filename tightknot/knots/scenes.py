@@ -23,7 +23,7 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   change dWr forces on a closed rod of conserved link (White 1969), small next to the
   bending energy of a tight knot (closed trefoils: default on, as the study joined them).
 * ``contact="compliant"`` (default): the radial-compliance layer with the FEM-calibrated
-  law (:class:`~tightknot.rods.contact_law.RadialComplianceLaw`, or the ``law`` given):
+  law (:class:`~tightknot.contact.law.RadialComplianceLaw`, or the ``law`` given):
   sections flatten and thin with stretch. Neglects friction, the coupling between the
   squeezes of neighbouring contacts on one section (each pair follows the single-pair
   fit) and any deformation beyond the calibrated range (overlap 0.3 D); and the section
@@ -31,19 +31,19 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   cross-check's indent force is 11 to 16 % short, docs/fem_crosscheck.md).
   ``contact="smoothed"``: the compliant law with the section thinned by the stretch
   averaged over +-:data:`SMOOTHED_RADIUS_WINDOW` D0 along the rod
-  (:mod:`tightknot.rods.section_radius`): the indent force within -8 to +7 % of the
+  (:mod:`tightknot.contact.section_radius`): the indent force within -8 to +7 % of the
   fine-mesh FEM, its axial force at the crossing 1.07 (deepest level) to 5 times the FEM's
   (compliant: 3.4 to 54 times); the knots come out
   the same within 1e-4 (closed trefoil at 16.37: stretch) to 3 % (the 185 mm knot's pulling
   force, reached at another Lambda_OC within its tolerance), in as many Newton iterations
   at 1.7 to 2.6 times the time (its Hessian couples whole windows of the rod;
-  bench/contact_levels.py). Not in the batch (:func:`tightknot.knots.batch.tie_batch`).
+  bench/contact_levels.py). Not in the batch (:func:`tightknot.loading.batch.tie_batch`).
   ``contact="rigid"``: the same layer with ``law.rigid_tube()``, 1000 times stiffer and a
   hard radius D0/2 that does not thin with stretch; neglects every deformation of the
   section (the ideal-knot tube); width, pressure and area are then not reported.
   ``contact="off"``: no contact layer (``KnotScene.contact`` is None); neglects
   self-contact entirely, so the rod may pass through itself: only for shapes without
-  contact (a loose start, the elastic cost alone in benchmarks); :func:`tightknot.knots.tie.tie`
+  contact (a loose start, the elastic cost alone in benchmarks); :func:`tightknot.loading.tie.tie`
   needs a contact layer to tie a knot.
 * Inertia is not a scene property: the static solvers (``solve_static``, ``newton_solve``)
   neglect it, the dynamic ones (``tightknot.solvers.dynamic``: implicit Euler, proximal
@@ -58,12 +58,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tightknot.contact.law import RadialComplianceLaw
+from tightknot.contact.layer import ContactLayer
 from tightknot.knots import curves
 from tightknot.knots.smoothing import gaussian_smooth_points
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
-from tightknot.rods.contact import ContactLayer
-from tightknot.rods.contact_law import RadialComplianceLaw
 from tightknot.rods.material import Material, check_positive
 from tightknot.rods.model import Model
 from tightknot.rods.state import State

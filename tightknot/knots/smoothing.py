@@ -24,8 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tightknot.knots._arclength import as_points, total_length
-from tightknot.knots.curves import resample_uniform
+from tightknot.knots._arclength import as_points, resample_uniform, total_length
 
 
 def gaussian_weights(std_points: float, half_width: int) -> NDArray[np.float64]:

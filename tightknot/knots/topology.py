@@ -369,3 +369,15 @@ def close_open_curve(
     path = [f_end, c + r_sphere * a, *(c + r_sphere * slerp(a, w, n_arc)), c + r_sphere * w,
             *(c + r_sphere * slerp(w, b, n_arc)), c + r_sphere * b, f_start]
     return np.vstack([p, np.asarray(path)])
+
+
+def curve_knot_type(points: ArrayLike, closed: bool) -> str:
+    """Knot type of a centerline (N, 3) [m] (an open one closed by a far-away arc,
+    :func:`close_open_curve`); "undefined" when no projection of it is generic (strands
+    within 1e-10 of its size: it passes through itself, or nearly), which a topology check
+    then reports as a change."""
+    pts = points if closed else close_open_curve(points)
+    try:
+        return knot_type(pts)
+    except TopologyError:
+        return "undefined (the curve nearly passes through itself)"

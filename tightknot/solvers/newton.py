@@ -163,7 +163,7 @@ def newton_solve(
 class Immediate:
     """A :class:`NewtonProblem` as a :class:`GeneratorProblem`: each question
     (evaluation, step bound, acceptance) is answered at once, and the Newton systems are
-    solved by the sparse direct solver. The batch of rods (:mod:`tightknot.knots.batch_newton`)
+    solved by the sparse direct solver. The batch of rods (:mod:`tightknot.solvers.lockstep`)
     answers the same questions for many rods together instead."""
 
     def __init__(self, problem: NewtonProblem) -> None:
@@ -224,7 +224,7 @@ def newton_gen(p: GeneratorProblem, u0: np.ndarray, options: NewtonOptions | Non
     """The damped Newton loop (module docstring) as a generator: every evaluation, step
     bound and acceptance is a sub-generator of the problem ``p`` (``yield from``), so one
     loop serves a problem answered at once (:class:`Immediate`, :func:`newton_solve`) and
-    rods whose questions are answered together (:mod:`tightknot.knots.batch_newton`).
+    rods whose questions are answered together (:mod:`tightknot.solvers.lockstep`).
     Returns the :class:`NewtonResult`."""
     opt = options or NewtonOptions()
     u = np.array(u0, dtype=np.float64)

@@ -13,7 +13,6 @@ Reference frames are carried from the last accepted state by time-parallel trans
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,26 +23,8 @@ from tightknot.rods.elastic import ElasticForces
 from tightknot.rods.model import Model
 from tightknot.rods.staging import Output
 from tightknot.rods.state import State
-from tightknot.solvers.contact_pattern import ContactPattern
-from tightknot.solvers.linear import SparsePattern
-
-
-class ExtraTerm(Protocol):
-    """An energy term added to the elastic rods (e.g. the contact layer)."""
-
-    name: str
-
-    def evaluate(
-        self, x: np.ndarray, rest: np.ndarray, want_grad: bool, want_hess: bool
-    ) -> tuple[float, np.ndarray | None, tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
-        """Energy [J] at positions ``x`` and edge rest lengths ``rest``, gradient over
-        position dofs (vertex_count, 3) [N], and Hessian COO triplets over global dofs
-        (rows, cols, values)."""
-        ...
-
-    def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
-        """Largest fraction in (0, 1] of the step ``dx`` that keeps the term valid."""
-        ...
+from tightknot.rods.term import EnergyTerm
+from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
 
 @dataclass
@@ -101,7 +82,7 @@ class RodSystem:
         self.state = state
         self.bcs = bcs if bcs is not None else BoundaryConditions(model)
         self.gravity = None if gravity is None else np.asarray(gravity, dtype=np.float64)
-        self.extra_terms: list[ExtraTerm] = []
+        self.extra_terms: list[EnergyTerm] = []
         self.inertia: Inertia | None = None
         self.pattern = SparsePattern(model, ~self.bcs.fixed_mask())
         self.forces = ElasticForces(model, self.pattern.joint_slot, self.pattern.edge_slot)
@@ -130,12 +111,10 @@ class RodSystem:
         self._trial: tuple[np.ndarray, ...] | None = None
         self.set_load(0.0)
 
-    def add_term(self, term: ExtraTerm) -> None:
-        """Add an energy term (e.g. the contact layer); a term that can check the state
-        (``check_no_intersection``) refuses a start that already violates it."""
-        check = getattr(term, "check_no_intersection", None)
-        if check is not None:
-            check(self.state.x)
+    def add_term(self, term: EnergyTerm) -> None:
+        """Add an energy term (e.g. the contact layer); it first checks the state
+        (``term.check_state``: a start that already violates it is refused)."""
+        term.check_state(self.state.x)
         self.extra_terms.append(term)
 
     # -- load path -------------------------------------------------------------------
@@ -199,8 +178,8 @@ class RodSystem:
         if grad is not None:
             grad[m.position_dofs] -= self.f_ext
         # Terms that add their Hessian straight into the CSC data (the contact layer) share
-        # one pattern that grows with the contact set (tightknot.solvers.contact_pattern).
-        direct = [t for t in self.extra_terms if want_hess and hasattr(t, "evaluate_into")]
+        # one pattern that grows with the contact set (tightknot.solvers.pattern).
+        direct = [t for t in self.extra_terms if want_hess and t.assembles_in_place]
         cdata = None
         results = {}
         if direct:
@@ -210,10 +189,13 @@ class RodSystem:
                 # One reused array (its first nnz entries zeroed), so that the contact
                 # kernel's recorded launch sees the same target at every evaluation.
                 cdata = self._cdata.get(self._cpattern.nnz, zero=True)
+                tables = self._cpattern.warp_tables(m.device)
                 for term in direct:
-                    results[id(term)] = term.evaluate_into(x, self.rest, self._cpattern, cdata)
+                    results[id(term)] = term.evaluate_into(x, self.rest, tables, cdata)
                     if results[id(term)][1] is None:
-                        break  # new contact blocks: the pattern grew, assemble again
+                        # New contact blocks: grow the pattern, assemble again.
+                        self._cpattern.grow(term.missing_blocks())
+                        break
                 else:
                     break
         for term in self.extra_terms:
@@ -261,7 +243,7 @@ class RodSystem:
         that only grows would carry stale zeros into every later factorization)."""
         if self._cpattern is None:
             return
-        keys = [t.active_blocks() for t in self.extra_terms if hasattr(t, "active_blocks")]
+        keys = [t.active_blocks() for t in self.extra_terms]
         self._cpattern.reset(np.concatenate(keys) if keys else np.zeros(0, np.int64))
 
     def _coo_free(self, parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> sp.csc_matrix:

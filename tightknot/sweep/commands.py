@@ -171,14 +171,13 @@ def _line(record: dict[str, Any], label: str) -> str:
 
 def run_command(args: argparse.Namespace) -> int:
     """Handler of ``tightknot sweep``: 0 every case ok, 1 a case failed, 2 bad input."""
-    from tightknot.atomic import write_json_atomic
-    from tightknot.cli import _writable_file
+    from tightknot.atomic import writable_file, write_json_atomic
     from tightknot.sweep.executors import make_executor
     from tightknot.sweep.store import Store
     from tightknot.sweep.sweep import run_sweep
     from tightknot.warp_setup import resolve_device
 
-    out_json = _writable_file(args.json)
+    out_json = writable_file(args.json)
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if args.scheduler is not None and args.executor != "dask":

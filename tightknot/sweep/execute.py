@@ -59,7 +59,7 @@ def solve_case(case: Case, device: str = "cpu") -> dict[str, Any]:
     p = case.params
     scene = build_scene(p, device)
     if p["knot"] == "closed":
-        from tightknot.knots.run import run_knot
+        from tightknot.study.run import run_knot
 
         run = run_knot(scene, tighten_steps=p["tighten_steps"], residual_tol=p["residual_tol"])
         ok = run.result.converged
@@ -110,7 +110,7 @@ def run_case(params: Mapping[str, Any], device: str = "cpu") -> dict[str, Any]:
 
 def run_batch(params_list: list[Mapping[str, Any]], device: str = "cpu") -> list[dict[str, Any]]:
     """The records of closed-knot cases tied together in one model
-    (:func:`tightknot.knots.batch.tie_batch`: every rod runs tie()'s own program, all rods'
+    (:func:`tightknot.loading.batch.tie_batch`: every rod runs tie()'s own program, all rods'
     evaluations answered by one set of launches per round), in the order given. Each
     record is that of :func:`run_case` (the same summary, measured the same way), with
     ``wall_time_s`` the whole batch's and ``batch`` saying which batch it was run in. Never
@@ -139,8 +139,8 @@ def run_batch(params_list: list[Mapping[str, Any]], device: str = "cpu") -> list
 def _solve_batch(cases: list[Case], device: str) -> list[dict[str, Any]]:
     import dataclasses
 
-    from tightknot.knots.batch import tie_batch
-    from tightknot.knots.run import measure_run
+    from tightknot.loading.batch import tie_batch
+    from tightknot.study.run import measure_run
 
     scenes = [build_scene(c.params, device) for c in cases]
     p0 = cases[0].params

@@ -1,12 +1,12 @@
 """Tightness sweep of an open knot along ONE continuation path.
 
-The knot is tied once (:func:`tightknot.knots.tie.tie`: rest length shrunk to L0, end held),
+The knot is tied once (:func:`tightknot.loading.tie.tie`: rest length shrunk to L0, end held),
 then pulled by a dead force on its sliding end, level after level, each level's equilibrium
 starting from the previous one. The levels are visited from the loosest to the tightest (a
 pull that only grows, as in the study's experiments; physics.md sec. 1): pulling forces in
 increasing order, or target knot lengths Lambda_OC in decreasing order. A force level is
 one static solve (split into smaller force steps where Newton fails); a Lambda_OC level is
-the search of :func:`tightknot.knots.tie.tie_to_lambda` (force steps until the target is
+the search of :func:`tightknot.loading.pull.tie_to_lambda` (force steps until the target is
 bracketed, then a search on the force inside the bracket) started from the previous level's
 force and shape instead of from the tied knot, its force predicted from the previous
 levels (secant in log F), and every solve starts from the secant extrapolation of the last
@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import (
     KnotScene,
     bending_force_scale,
@@ -37,7 +38,7 @@ from tightknot.knots.scenes import (
     gauge,
     vertex_radii,
 )
-from tightknot.knots.tie import TieResult, end_reaction, knot_type_of, lambda_oc, tie
+from tightknot.loading.tie import TieResult, end_reaction, knot_type_of, tie
 from tightknot.solvers.newton import NewtonOptions, newton_solve
 from tightknot.solvers.system import RodSystem
 
@@ -61,7 +62,7 @@ class LevelResult:
         newton_iterations: Newton iterations of this level's solves (from the previous level).
         solves: static solves of this level (failed ones included).
         wall_time_s: wall-clock time of this level, its measurements included [s].
-        summary: the knot summary at the level (keys of :func:`tightknot.knots.run.summarise`;
+        summary: the knot summary at the level (keys of :func:`tightknot.study.run.summarise`;
             its newton_iterations and wall_time_s are this level's), None when not reached.
     """
 
@@ -110,7 +111,7 @@ class PathResult:
 
 class _Pull:
     """The pulled knot: a dead force on the sliding end, stepped from equilibrium to
-    equilibrium (the pull set-up of :func:`tightknot.knots.tie.tie_to_lambda`)."""
+    equilibrium (the pull set-up of :func:`tightknot.loading.pull.tie_to_lambda`)."""
 
     def __init__(self, scene: KnotScene, tied: TieResult, residual_tol: float,
                  proximal_steps: int, predictor: bool = True) -> None:
@@ -142,7 +143,7 @@ class _Pull:
     def solve(self, f: float) -> str:
         """Equilibrium under force ``f`` [N] from the current state; "" on success, else
         the reason (the state is then put back)."""
-        from tightknot.knots.tie import recentre_system
+        from tightknot.loading.recentre import recentre_system
         from tightknot.solvers.dynamic import proximal_relax
 
         _, moved = recentre_system(self.scene, self.system)
@@ -339,10 +340,10 @@ class _Pull:
 
 def measure(scene: KnotScene, result: TieResult) -> dict:
     """The knot summary of ``result``'s state (the measurements of
-    :func:`tightknot.knots.run.run_knot`, same keys)."""
+    :func:`tightknot.study.run.run_knot`, same keys)."""
+    from tightknot.contact.report import contact_report
     from tightknot.knots.measure import analyze_centerline
-    from tightknot.knots.run import CONTACT_TOL, summarise
-    from tightknot.rods.contact import contact_report
+    from tightknot.study.run import CONTACT_TOL, summarise
 
     x = result.system.state.x
     _, r_v = vertex_radii(scene, x, result.system.rest)

@@ -20,9 +20,9 @@ from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment, section_area
 from tightknot.rods.model import Model
 from tightknot.rods.state import State
+from tightknot.solvers.continuation import ContinuationOptions, solve_static
 from tightknot.solvers.dynamic import implicit_euler_step, kinetic_energy
 from tightknot.solvers.newton import newton_solve
-from tightknot.solvers.static import ContinuationOptions, solve_static
 from tightknot.solvers.system import RodSystem
 from tightknot.verification.elastica import cantilever_tip
 

@@ -1,0 +1,1 @@
+"""Contact between rods: the law, the broad phase, the energy term, the step bound, the report."""

@@ -1,0 +1,293 @@
+"""The rod model in the FEM's scenes: a crossing (indent) and a wrap, solved level by level.
+
+The same load levels and parameters as the FEM scenes of :mod:`tightknot.fem.scenes`, on
+the rod model with its contact layer (the rigid counter-bodies as rods of a law scaled to a
+rigid partner, :func:`rigid_counterbody_law`); :mod:`tightknot.fem.crosscheck` compares the
+two.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from .material import ROD_DIAMETER, YOUNGS_MODULUS
+
+EDGES_PER_D0: int = 12
+"""Rod-model edges per diameter: the resolution of the knot scenes (closed trefoil: 200
+nodes over 16.37 D0, open trefoil: 300 over 21.8 D0), so that the check speaks for them.
+The smallest compared point contact (w = 0.0015 D0) has a patch radius sqrt(D0 w) =
+0.04 D0, below one Gauss spacing: its force is expected to be the least accurate."""
+
+DENSITY: float = 1160.0
+"""Density [kg/m^3] of the rod model's material (statics: it plays no role)."""
+
+
+def rigid_counterbody_law(law: Any) -> Any:
+    """The pair law of a rod against a rigid body of the same diameter: k 2^p for the line
+    and point laws, so that the kernel's f(delta/2) becomes the per-side f(w = delta)."""
+    return replace(law, k_line=law.k_line * 2.0**law.p_line,
+                   k_point=law.k_point * 2.0**law.p_point,
+                   source=f"rigid counter-body (w = delta) of {law.source}")
+
+
+def _line_points(start: np.ndarray, end: np.ndarray, edges: int) -> np.ndarray:
+    return np.linspace(start, end, edges + 1)
+
+
+class _Path:
+    """A load value moved linearly from ``a`` to ``b`` along the load parameter t."""
+
+    def __init__(self) -> None:
+        self.a = 0.0
+        self.b = 0.0
+
+    def __call__(self, t: float) -> float:
+        return self.a + t * (self.b - self.a)
+
+    def advance(self, value: float) -> None:
+        self.a, self.b = self.b, value
+
+
+def _solve_levels(system: Any, path: _Path, levels: list[float],
+                  measure: Any) -> list[dict[str, Any]]:
+    """Solve each level from the last one. From the third level on, Newton starts from
+    the linear extrapolation (in the load value) of the last two equilibria (measured:
+    26 instead of 29 iterations over the wrap's 6 levels, 29 either way on the indent's
+    10); a failed solve retries smaller steps from the last equilibrium without it."""
+    from tightknot.solvers.continuation import ContinuationOptions, solve_static
+
+    rows = []
+    history: list[tuple[float, np.ndarray]] = []
+    for value in levels:
+        path.advance(value)
+        predictor = None
+        if len(history) >= 2 and history[-1][0] != history[-2][0]:
+            (v1, u1), (v2, u2) = history[-2], history[-1]
+            guess = u2 + (value - v2) / (v2 - v1) * (u2 - u1)
+
+            def predictor(sys_: Any, t: float, t_next: float, guess: np.ndarray = guess
+                          ) -> None:
+                if t == 0.0 and t_next == 1.0:  # the whole level in one step only
+                    sys_.accept(guess)
+
+        result = solve_static(system, ContinuationOptions(steps=1), predictor=predictor)
+        history.append((value, system.free_vector()))
+        row = measure(value)
+        row["converged"] = bool(result.converged)
+        row["newton_iterations"] = int(result.newton_iterations)
+        rows.append(row)
+    return rows
+
+
+def _section_stretch(layer: Any, x: np.ndarray, model: Any, mid: int, own: float) -> float:
+    """The stretch that thins the rod's mid section: ``own`` (the mid edges' mean) or, with a
+    radius window, the layer's window mean over the two mid edges."""
+    if layer.radius_window == 0.0:
+        return own
+    lam = layer.section_stretch(x, model.edge_rest_length)
+    e0 = model.rods[0].edge_start
+    return float(0.5 * (lam[e0 + mid - 1] + lam[e0 + mid]))
+
+
+def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
+               youngs_modulus: float = YOUNGS_MODULUS, length_over_d0: float = 3.0,
+               law: Any = None, poisson_ratio: float = 0.5,
+               radius_window: float = 0.0) -> dict[str, Any]:
+    """The indent scene with the rod model: a straight rod (axis e_z) between two pinned
+    rods along e_x that move toward its axis by w [m] each (``w_levels``).
+
+    ``poisson_ratio`` of the rod (a diagnostic at 0: the contact radius r0 lambda^(-nu)
+    then does not thin with stretch; the straight rod's bending plays no role).
+    ``radius_window``: the contact layer's (:class:`tightknot.contact.layer.ContactLayer`).
+    Returns per level: ``force`` [N] from the upper indenter, ``overlap_over_d0``,
+    ``axial_force_mid_over_e_d0sq`` (the contact forces' axial resultant on one half),
+    ``area_ratio_mid``, ``peak_pressure_over_e``, and the wall time.
+    """
+    from tightknot.contact.law import RadialComplianceLaw
+    from tightknot.contact.layer import ContactLayer
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    start = time.perf_counter()
+    law = law or RadialComplianceLaw.from_json()
+    pair_law = rigid_counterbody_law(law)
+    d0 = diameter
+    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod += n_rod % 2  # even: a vertex at z = 0
+    n_obs = 4 * EDGES_PER_D0
+    half = 0.5 * length_over_d0 * d0
+    mat = Material(youngs_modulus, 0.5, DENSITY)
+    b = RodBuilder(twist=False)
+    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0,
+              Material(youngs_modulus, poisson_ratio, DENSITY))
+    for sign in (1.0, -1.0):  # indenters above and below, touching at rest
+        b.add_rod(_line_points(np.array([-2 * d0, sign * d0, 0]),
+                               np.array([2 * d0, sign * d0, 0]), n_obs), d0, mat)
+    model = b.finalize()
+    path = _Path()
+    bcs = BoundaryConditions(model)
+    for rod, sign in ((1, 1.0), (2, -1.0)):
+        for k in range(n_obs + 1):
+            bcs.pin(rod, k, translation=lambda t, s=sign: np.array([0.0, -s * path(t), 0.0]))
+    mid = n_rod // 2
+    for k in range(n_rod + 1):
+        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
+    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
+    # rigid tilt about x is force-free between two crossing cylinders: gauge it at the
+    # ends (their reactions vanish by the up-down symmetry)
+    bcs.fix_components(0, 0, (1,))
+    bcs.fix_components(0, -1, (1,))
+    system = RodSystem(model, State.initial(model), bcs)
+    layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window)
+    system.add_term(layer)
+    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
+    up_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+
+    def measure(w: float) -> dict[str, Any]:
+        x = system.state.x
+        _, g, _ = layer.evaluate(x, model.edge_rest_length, True, False)
+        # the pair's forces are equal and opposite: the upper indenter's (on it, -g) is the
+        # magnitude of the force on the rod
+        force = -float(g[up_v, 1].sum())
+        # footprint: rms distance of the upper indenter's contact force from the crossing,
+        # along the indenter (by the 90-degree symmetry of the kernel also along the rod)
+        f_up = -g[up_v, 1]
+        rms = math.sqrt(float((f_up * x[up_v, 0] ** 2).sum()) / force) if force > 0 else 0.0
+        # axial force in the mid section (tension > 0): the contact forces' z components
+        # on the z > 0 half (force on the rod: -g)
+        axial = -float(g[rod_v[mid + 1:], 2].sum())
+        xm = x[rod_v[mid]]
+        y_up = x[up_v[0], 1]
+        dist = math.hypot(y_up - xm[1], xm[2])
+        e = np.linalg.norm(np.diff(x[rod_v], axis=0), axis=1)
+        stretch = float(0.5 * (e[mid - 1] + e[mid]) / (2.0 * half / n_rod))
+        sec = _section_stretch(layer, x, model, mid, stretch)
+        overlap = d0 / 2.0 * sec**-0.5 + d0 / 2.0 - dist
+        w_side = max(overlap, 0.0)  # rigid indenter: the rod takes the whole overlap
+        return {
+            "w_over_d0": w / d0,
+            "approach_over_d0": 2.0 * w / d0,
+            "force": force,
+            "force_over_e_d0sq": force / (youngs_modulus * d0**2),
+            "overlap_over_d0": overlap / d0,
+            "axial_stretch_mid": stretch,
+            "axial_force_mid_over_e_d0sq": axial / (youngs_modulus * d0**2),
+            "area_ratio_mid": float(law.area_factor(w_side, d0)) / sec,
+            "peak_pressure_over_e": float(law.peak_pressure_point(w_side, d0)),
+            "semi_axis_over_d0": float(law._power(law.k_patch, law.p_patch, w_side, d0)),
+            "force_rms_halfwidth_over_d0": rms / d0,
+        }
+
+    rows = _solve_levels(system, path, list(w_levels), measure)
+    return {"steps": rows, "wall_time_s": time.perf_counter() - start,
+            "vertices": int(model.vertex_count), "law": pair_law.source}
+
+
+def wrap_constraints(bcs: Any, n_rod: int, theta: float, path: _Path) -> int:
+    """The wrapped rod's (rod 0, ``n_rod`` edges) constraints of the wrap scene: the plane
+    x = 0, the symmetry plane z = 0 at its middle vertex, and dead end forces
+    ``path(t)`` (0, sin(theta), +-cos(theta)) [N]. Returns the middle vertex."""
+    mid = n_rod // 2
+    for k in range(n_rod + 1):
+        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
+    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
+    s, c = math.sin(theta), math.cos(theta)
+    bcs.force(0, 0, lambda t: path(t) * np.array([0.0, s, -c]))
+    bcs.force(0, -1, lambda t: path(t) * np.array([0.0, s, c]))
+    return mid
+
+
+def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
+             diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
+             length_over_d0: float = 4.5, law: Any = None,
+             radius_window: float = 0.0) -> dict[str, Any]:
+    """The wrap scene with the rod model: a rod (axis e_z at rest) pulled by dead end
+    forces T (0, sin(theta), +-cos(theta)) around a pinned rod along e_x above it.
+
+    Returns per tension level [N]: ``force_per_length_mid`` [N/m] (contact line load at
+    the middle vertex over its deformed Voronoi length), ``contact_force_total`` [N],
+    ``approach_over_d0``, ``overlap_over_d0``, ``area_ratio_mid``, ``kappa_d0_mid``
+    (Bergou curvature), ``peak_pressure_over_e`` and the wall time. ``radius_window``: the
+    contact layer's (:class:`tightknot.contact.layer.ContactLayer`).
+    """
+    from tightknot.contact.law import RadialComplianceLaw
+    from tightknot.contact.layer import ContactLayer
+    from tightknot.knots.curvature import bergou_curvature
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    start = time.perf_counter()
+    law = law or RadialComplianceLaw.from_json()
+    pair_law = rigid_counterbody_law(law)
+    d0 = diameter
+    theta = 0.5 * math.radians(wrap_angle_deg)
+    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod += n_rod % 2
+    n_obs = 4 * EDGES_PER_D0
+    half = 0.5 * length_over_d0 * d0
+    s0 = 0.01 * d0  # initial overlap: the rod floats on the contact (see scenes.wrap)
+    y_obs = d0 - s0
+    mat = Material(youngs_modulus, 0.5, DENSITY)
+    b = RodBuilder(twist=False)
+    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
+    b.add_rod(_line_points(np.array([-2 * d0, y_obs, 0]), np.array([2 * d0, y_obs, 0]),
+                           n_obs), d0, mat)
+    model = b.finalize()
+    path = _Path()
+    bcs = BoundaryConditions(model)
+    for k in range(n_obs + 1):
+        bcs.pin(1, k)
+    mid = wrap_constraints(bcs, n_rod, theta, path)
+    system = RodSystem(model, State.initial(model), bcs)
+    layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window)
+    system.add_term(layer)
+    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
+    obs_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+
+    def measure(tension: float) -> dict[str, Any]:
+        x = system.state.x
+        _, g, _ = layer.evaluate(x, model.edge_rest_length, True, False)
+        total = float(np.linalg.norm(g[obs_v].sum(axis=0)))
+        xr = x[rod_v]
+        e = np.linalg.norm(np.diff(xr, axis=0), axis=1)
+        voronoi = 0.5 * (e[mid - 1] + e[mid])
+        f_mid = float(np.linalg.norm(g[rod_v[mid]])) / voronoi
+        stretch = float(voronoi / (2.0 * half / n_rod))
+        sec = _section_stretch(layer, x, model, mid, stretch)
+        xm = xr[mid]
+        dist = math.hypot(y_obs - xm[1], xm[2])
+        overlap = d0 / 2.0 * sec**-0.5 + d0 / 2.0 - dist
+        w_side = max(overlap, 0.0)  # rigid cylinder: the rod takes the whole overlap
+        kappa = float(bergou_curvature(xr, closed=False)[mid])
+        return {
+            "tension": tension,
+            "tension_over_e_d0sq": tension / (youngs_modulus * d0**2),
+            "approach_over_d0": (d0 - dist) / d0,
+            "overlap_over_d0": overlap / d0,
+            "axial_stretch_mid": stretch,
+            "contact_force_total": total,
+            "force_per_length_mid": f_mid,
+            "force_per_length_mid_over_e_d0": f_mid / (youngs_modulus * d0),
+            # one-sided: diameter reduction delta, i.e. delta/2 per side on average
+            "area_ratio_mid": float(law.area_factor(0.5 * w_side, d0)) / sec,
+            "kappa_d0_mid": kappa * d0,
+            # the kernel blends to the point law at crossing angles above 35 degrees
+            # (here 90): its pressure law; the line law's value for comparison
+            "peak_pressure_over_e": float(law.peak_pressure_point(w_side, d0)),
+            "peak_pressure_line_law_over_e": float(law.peak_pressure_line(w_side, d0)),
+        }
+
+    rows = _solve_levels(system, path, list(tension_levels), measure)
+    return {"steps": rows, "wall_time_s": time.perf_counter() - start,
+            "vertices": int(model.vertex_count), "law": pair_law.source}

@@ -1,0 +1,1 @@
+"""Load paths: tying, tightening and pulling knots, one rod or a batch."""

@@ -1,0 +1,298 @@
+"""Tying and tightening the study's knots: the load paths that solve a :class:`KnotScene`.
+
+Phase 1 (``tighten``): the rest length shrinks from the scene's start length to L0; an open
+knot's end slides freely along the pull axis under a small tension (``hold_force``), so
+the tails feed the knot as it closes. Phase 2 (``pull``, open knots): the sliding end is
+pulled along the axis by a dead force growing geometrically to the target, or moved to a
+target end-to-end distance. After every converged load step the knot type is checked
+(Alexander polynomial); a change stops the run as failed (physics.md sec. 2: a knot that
+passed through itself has failed).
+
+An open knot is kept centred on its rod: after the relaxation, after every converged load
+step but the last, and before every force of ``tie_to_lambda``, its material slides along
+the rod until the knot's centre is mid-rod (``recentre_open_knot``). Without friction the
+knot's place along the rod is a zero mode of the energy, and the short tails of the
+study's 185 mm knot (3.9 D0 each at Lambda_OC 15) leave no room for the drift that
+round-off otherwise steers (tests/loading/test_recentre.py). A rod with twist is not
+re-centred (its twist field would have to slide too). The returned equilibrium is always
+a converged solve; a slide is followed by one.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from tightknot.knots import topology
+from tightknot.knots.scenes import (
+    KnotScene,
+    bending_force_scale,
+    end_vertex,
+    gauge,
+)
+from tightknot.loading.recentre import recentre_system
+from tightknot.rods.state import State
+from tightknot.solvers.continuation import (
+    ContinuationOptions,
+    StaticResult,
+    StepRecord,
+    continuation_gen,
+)
+from tightknot.solvers.dynamic import ImmediateSystem
+from tightknot.solvers.newton import NewtonOptions, newton_gen, run_now
+from tightknot.solvers.system import RodSystem
+
+StepHook = Callable[[str, RodSystem, StepRecord], None]
+
+
+@dataclass
+class TieResult:
+    """Outcome of tying a knot.
+
+    Attributes:
+        converged: every phase reached its end.
+        failure: what failed and where ("" when converged).
+        phases: the continuation result of each phase, by name.
+        newton_iterations: total Newton iterations.
+        wall_time_s: wall-clock time [s].
+        knot_types: knot type after each converged load step.
+        pull_force_N: final pulling force (open knots) [N].
+        system: the last phase's system (its state is the result; after a failed load
+            step, the last equilibrium).
+        failed_state: where the failing load step's solve stopped (None when converged).
+    """
+
+    converged: bool
+    failure: str
+    phases: dict[str, StaticResult]
+    newton_iterations: int
+    wall_time_s: float
+    knot_types: list[str] = field(default_factory=list)
+    pull_force_N: float = 0.0
+    system: RodSystem | None = None
+    failed_state: State | None = None
+
+
+def knot_type_of(scene: KnotScene, x: np.ndarray) -> str:
+    """Knot type of the scene's centerline ``x`` [m]
+    (:func:`tightknot.knots.topology.curve_knot_type`)."""
+    return topology.curve_knot_type(x, scene.closed)
+
+
+def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | None,
+             knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of):
+    def check(system: RodSystem, rec: StepRecord) -> str | None:
+        kt = knot_type(scene, system.state.x)
+        types.append(kt)
+        if hook is not None:
+            hook(phase, system, rec)
+        if kt != scene.knot_type:
+            why = ("the rod passed through itself" if scene.closed else
+                   "the knot slipped off an end, or the rod passed through itself")
+            return (f"topology changed in phase {phase} at load t={rec.t:.4g}: knot type "
+                    f"{kt}, expected {scene.knot_type} ({why})")
+        # The next load step starts from the knot centred on its rod (open knots); the
+        # last step's equilibrium is the phase's result and stays as it is.
+        if rec.t < 1.0 - 1e-12:
+            recentre_system(scene, system)
+        return None
+    return check
+
+
+def _opts(steps: int, tol: float) -> ContinuationOptions:
+    # Knots have limit points along their paths (a loop that flips, a tail that slides
+    # through): proximal steps carry the solve through them (proximal_dt).
+    return ContinuationOptions(steps=steps, max_step=1.0 / steps, min_step=1e-4,
+                               newton=NewtonOptions(residual_tol=tol, max_iterations=60),
+                               proximal_dt=1e-3, proximal_steps=200)
+
+
+def tie(
+    scene: KnotScene,
+    pull_force: float | None = None,
+    end_distance: float | None = None,
+    tighten_steps: int = 20,
+    pull_steps: int = 20,
+    residual_tol: float = 1e-6,
+    hold_force_scale: float = 0.05,
+    relax_iterations: int = 2000,
+    hook: StepHook | None = None,
+) -> TieResult:
+    """Tie ``scene``: shrink its rest length to L0, then (open knots) pull.
+
+    Args:
+        pull_force: final pulling force [N] (open knots).
+        end_distance: final end-to-end distance [m] (open knots; instead of a force).
+        tighten_steps, pull_steps: initial numbers of load steps (adaptive afterwards).
+        residual_tol: Newton tolerance on the scaled residual.
+        hold_force_scale: tension on a sliding end while tightening, over EI/D0^2.
+        relax_iterations: Newton budget of the relaxation of the start curve.
+        hook: called after each converged step with (phase, system, record).
+    """
+    return run_now(tie_gen(scene, pull_force, end_distance, tighten_steps, pull_steps,
+                           residual_tol, hold_force_scale, relax_iterations, hook))
+
+
+def tie_gen(
+    scene: KnotScene,
+    pull_force: float | None = None,
+    end_distance: float | None = None,
+    tighten_steps: int = 20,
+    pull_steps: int = 20,
+    residual_tol: float = 1e-6,
+    hold_force_scale: float = 0.05,
+    relax_iterations: int = 2000,
+    hook: StepHook | None = None,
+    problem: Callable[[RodSystem], Any] = ImmediateSystem,
+    start_state: State | None = None,
+    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
+):
+    """:func:`tie` as a generator of the solvers' questions (:mod:`tightknot.solvers.newton`):
+    every phase's system is handed to the solvers as ``problem(system)`` (default: answered
+    at once; a batch of rods answers many rods' questions together,
+    :mod:`tightknot.loading.batch`), starting from ``start_state`` (default: the scene's), with the
+    knot type computed by ``knot_type``. Returns the :class:`TieResult`."""
+    if scene.contact is None:
+        raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
+                         "the rod passes through itself); use 'compliant', 'smoothed' or 'rigid'")
+    if pull_force is not None and end_distance is not None:
+        raise ValueError("give pull_force or end_distance, not both")
+    if scene.closed and (pull_force is not None or end_distance is not None):
+        raise ValueError("a closed knot is not pulled: pull_force/end_distance are for open knots")
+    if pull_force is not None and not (math.isfinite(pull_force) and pull_force > 0):
+        raise ValueError(f"pull_force must be finite and > 0 N, got {pull_force!r}")
+    if end_distance is not None and not (math.isfinite(end_distance) and end_distance > 0):
+        raise ValueError(f"end_distance must be finite and > 0 m, got {end_distance!r}")
+    start = time.perf_counter()
+    types: list[str] = []
+    phases: dict[str, StaticResult] = {}
+    iters = 0
+    model = scene.model
+    f_unit = bending_force_scale(scene)
+    last = end_vertex(scene)
+    hold = hold_force_scale * f_unit
+    axis = scene.pull_axis if scene.pull_axis is not None else np.zeros(3)
+
+    def fail(msg: str, system: RodSystem | None, force: float,
+             failed_state: State | None = None) -> TieResult:
+        return TieResult(False, msg, phases, iters, time.perf_counter() - start, types,
+                         force, system, failed_state)
+
+    # Phase 1: shrink the rest length from the start to L0.
+    shrink = 1.0 / scene.start_length_ratio
+    # The start curve is not an equilibrium: relax it first (an open knot's end sliding
+    # under a small tension, so the loose loops do not swing freely), with a budget for the
+    # long, floppy path of a loose knot (measured: 150 iterations for 150 vertices).
+    bcs = gauge(scene)
+    if not scene.closed:
+        bcs.force(0, last, lambda t: hold * axis)
+    system = RodSystem(model, scene.state if start_state is None else start_state, bcs)
+    system.add_term(scene.contact)
+    p = problem(system)
+    p.set_load(0.0)
+    relax = yield from newton_gen(p, system.free_vector(), NewtonOptions(
+        residual_tol=residual_tol, max_iterations=relax_iterations))
+    iters += relax.iterations
+    if not relax.converged:
+        return fail(f"relax: Newton {relax.reason} (residual {relax.residual:.3g}) at the start",
+                    system, hold)
+    kt = knot_type(scene, system.state.x)
+    types.append(kt)
+    if kt != scene.knot_type:
+        return fail(f"relax: knot type {kt}, expected {scene.knot_type}", system, hold)
+    recentre_system(scene, system)
+    if scene.closed:
+        bcs = gauge(scene, positions=system.state.x)
+    else:
+        # The end then follows the shrink (end-to-end distance scaled with the rest
+        # length): with a freely sliding end the tail slides out of the shrinking loop and
+        # the knot slips off the rod (measured: knot type 0_1 at 55 % of the path).
+        bcs = gauge(scene, positions=system.state.x, sliding_end=False)
+        span = float(system.state.x[last] @ axis)
+        bcs.pin(0, last, translation=lambda t: (shrink - 1.0) * t * span * axis)
+    bcs.rest_length_scale((1.0, shrink))
+    system = RodSystem(model, system.state, bcs)
+    system.add_term(scene.contact)
+    p = problem(system)
+    p.set_load(0.0)
+
+    def similar(sys_: RodSystem, t0: float, t1: float) -> None:
+        # Self-similar predictor: the previous equilibrium scaled about the pinned first
+        # vertex (the origin) by the change of rest length keeps every strain; prescribed
+        # ends and the gauge's zero coordinates are unchanged by it. (``sys_``: the
+        # system, or a batch's rod: what has ``state`` and ``set_load``.)
+        c = (1.0 + (shrink - 1.0) * t1) / (1.0 + (shrink - 1.0) * t0)
+        sys_.state.x = sys_.state.x * c
+        sys_.set_load(t1)
+
+    res = yield from continuation_gen(p, _opts(tighten_steps, residual_tol),
+                                      _checker(scene, "tighten", types, hook, knot_type),
+                                      similar)
+    phases["tighten"] = res
+    iters += res.newton_iterations
+    if not res.converged:
+        return fail(f"tighten: {res.failure}", system, hold, res.failed_state)
+    if scene.closed or (pull_force is None and end_distance is None):
+        return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
+                         hold if not scene.closed else 0.0, system)
+
+    # Phase 2: pull. The end's force at the tightened equilibrium, then the knot centred
+    # on its rod.
+    f_end = end_reaction(system)
+    recentre_system(scene, system)
+    state = system.state
+    bcs = gauge(scene, positions=state.x)
+    bcs.rest_length_scale((shrink, shrink))
+    if pull_force is not None:
+        # Start from the force the pinned end carried at the end of the tightening (a jump
+        # down to a small dead load would release the knot, and it slips off the rod).
+        f0 = max(f_end, hold)
+
+        def force_path(t: float) -> np.ndarray:
+            return f0 * (pull_force / f0) ** t * axis
+
+        bcs.force(0, last, force_path)
+        final_force = pull_force
+    else:
+        # (after the re-centring, which moves the end by up to an edge's stretch change)
+        d_now = float(np.linalg.norm(state.x[last] - state.x[0]))
+        delta = end_distance - d_now
+        bcs = gauge(scene, positions=state.x, sliding_end=False)
+        bcs.rest_length_scale((shrink, shrink))
+        bcs.pin(0, last, translation=delta * axis)
+        final_force = math.nan
+    system = RodSystem(model, state, bcs)
+    system.add_term(scene.contact)
+    p = problem(system)
+    p.set_load(0.0)
+    res = yield from continuation_gen(p, _opts(pull_steps, residual_tol),
+                                      _checker(scene, "pull", types, hook, knot_type))
+    phases["pull"] = res
+    iters += res.newton_iterations
+    if end_distance is not None:
+        # Reaction at the moved end: the residual force there is the pulling force.
+        final_force = end_reaction(system)
+    if not res.converged:
+        return fail(f"pull: {res.failure}", system, final_force, res.failed_state)
+    return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
+                     final_force, system)
+
+
+def end_reaction(system: RodSystem) -> float:
+    """Axial force [N] needed to hold the last vertex where it is (the pulling force)."""
+    model = system.model
+    x = system.state.x
+    # At equilibrium of the free dofs, the external force on the held vertex balances the
+    # gradient of the internal energy there: f = dE/dx_end.
+    _, grad = system.forces.evaluate(x, system.state.theta, system.state.m_ref, system.rest,
+                                     True, None)
+    g = grad[model.position_dofs][-1].copy()
+    for term in system.extra_terms:
+        _, gk, _ = term.evaluate(x, system.rest, True, False)
+        g += gk[-1]
+    return float(g[0])

@@ -1,0 +1,64 @@
+"""The interface of an energy term added to the elastic rods (the contact layer, an obstacle).
+
+A :class:`tightknot.solvers.system.RodSystem` owns the model's elastic energy and its sparse
+Hessian pattern; extra terms add their energy, gradient and Hessian through the methods
+below, which are all the system calls. A term either returns its Hessian as COO triplets
+(:meth:`EnergyTerm.evaluate`) or, with ``assembles_in_place``, adds it straight into the
+system's CSC data through the block tables of the system's pattern
+(:meth:`EnergyTerm.evaluate_into`); then the system asks which blocks were missing and grows
+its pattern, and between load steps asks which blocks still interact and compacts it.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+import warp as wp
+
+#: COO triplets (rows, cols, values) over global dofs.
+Coo = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+class EnergyTerm(Protocol):
+    """An energy term over a model's vertex positions. Subclass it to get the defaults
+    (no in-place assembly, no blocks, no step bound, no state check)."""
+
+    #: Name of the term in the system's energy split.
+    name: str = "term"
+    #: The term adds its Hessian into the system's CSC data (:meth:`evaluate_into`).
+    assembles_in_place: bool = False
+
+    def evaluate(self, x: np.ndarray, rest: np.ndarray, want_grad: bool,
+                 want_hess: bool) -> tuple[float, np.ndarray | None, Coo | None]:
+        """Energy [J] at positions ``x`` [m] (vertex_count, 3) and edge rest lengths
+        ``rest`` [m], its gradient over the positions (vertex_count, 3) [N] (None unless
+        asked) and its Hessian as COO triplets over global dofs (None unless asked)."""
+        ...
+
+    def evaluate_into(self, x: np.ndarray, rest: np.ndarray, tables: tuple[wp.array, ...],
+                      data: wp.array) -> tuple:
+        """Energy [J] and gradient (vertex_count, 3) [N], the Hessian added into ``data``
+        (CSC data, zeroed by the caller) through the block ``tables`` of the system's
+        pattern. The gradient is None when a block was missing from the tables (the
+        caller grows its pattern by :meth:`missing_blocks` and evaluates again); a third
+        item may hold Hessian terms outside the pair blocks (COO over global dofs)."""
+        raise NotImplementedError(f"{type(self).__name__} does not assemble in place")
+
+    def missing_blocks(self) -> np.ndarray:
+        """Vertex-block keys ``vr * V + vc`` the last :meth:`evaluate_into` needed."""
+        return np.zeros(0, dtype=np.int64)
+
+    def active_blocks(self) -> np.ndarray:
+        """Vertex-block keys of what interacted at the last evaluation (kept when the
+        system compacts its pattern between load steps)."""
+        return np.zeros(0, dtype=np.int64)
+
+    def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
+        """Largest fraction in (0, 1] of the step ``dx`` [m] that keeps the term valid."""
+        return 1.0
+
+    def check_state(self, x: np.ndarray) -> None:
+        """Raise ValueError when positions ``x`` [m] are outside the term's domain (e.g.
+        rods that already pass through each other)."""
+        return None

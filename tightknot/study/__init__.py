@@ -1,0 +1,1 @@
+"""One knot studied end to end: tied, measured, summarised, logged, drawn."""

@@ -1,0 +1,310 @@
+"""One knot run: tie a scene, log it to rerun, measure it, summarise it, draw its figures.
+
+Shared by ``tightknot tie`` and the demo, so both report the same quantities with the
+same keys (the knots issue's JSON summary).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tightknot.contact.report import ContactReport, contact_report
+from tightknot.knots.curvature import bergou_curvature
+from tightknot.knots.ideal import load_ideal_trefoil
+from tightknot.knots.measure import analyze_centerline
+from tightknot.knots.open_measures import lambda_oc
+from tightknot.knots.scenes import KnotScene, vertex_radii
+from tightknot.loading.pull import tie_to_lambda
+from tightknot.loading.tie import TieResult, end_reaction, tie
+from tightknot.solvers.system import RodSystem
+from tightknot.viz.rerun_log import ROD_FIELDS
+
+#: Contact tolerance of the measurements (the default of tightknot.knots.measure).
+CONTACT_TOL = 0.01
+
+
+@dataclass
+class KnotRun:
+    """A finished run: the tie result, the study's measurements, the contact outputs and the
+    JSON summary."""
+
+    scene: KnotScene
+    result: TieResult
+    report: dict
+    contact: ContactReport
+    summary: dict
+
+
+#: Fields the rod tube can be coloured by.
+COLOR_FIELDS = tuple(ROD_FIELDS)
+
+#: progress(phase, t, step): called after each converged load step with the phase name,
+#: its load parameter t in [0, 1] and the step's index on the load_step timeline.
+ProgressCallback = Callable[[str, float, int], None]
+
+
+def rod_field(name: str, scene: KnotScene, x: np.ndarray, rest: np.ndarray,
+              rep: ContactReport) -> tuple[np.ndarray, str]:
+    """Values of colouring field ``name`` at centerline ``x`` [m] and where they live.
+
+    kappa_D0: Bergou curvature times D0 per vertex; area_ratio: A/A0 per vertex and
+    contact_width_fraction: L_c per vertex (contact report); stretch: |e|/|e0| per edge
+    (``rest``: the edge rest lengths of the current load [m]).
+    """
+    if name == "kappa_D0":
+        return bergou_curvature(x, scene.closed) * scene.diameter, "vertex"
+    if name == "area_ratio":
+        return rep.area_ratio, "vertex"
+    if name == "contact_width_fraction":
+        return rep.contact_width_fraction, "vertex"
+    if name == "stretch":
+        ev = scene.model.edge_vertex
+        return np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1) / rest, "edge"
+    raise ValueError(f"unknown colouring field {name!r}; valid: {', '.join(COLOR_FIELDS)}")
+
+
+def check_color_field(name: str) -> str:
+    """``name`` if it is a colouring field, else ValueError naming the valid ones."""
+    if name not in COLOR_FIELDS:
+        raise ValueError(f"--color-by {name!r}: unknown field; valid: {', '.join(COLOR_FIELDS)}")
+    return name
+
+
+def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
+              color_by: str = "kappa_D0") -> None:
+    """Log the rod (tube coloured by ``color_by``, deformed radii) and its contact pairs
+    (coloured by peak p/E) at the logger's current step; open knots also get their
+    end-to-end distance [m], pulling force [N] and Lambda_OC [1] (when in contact)."""
+    x = system.state.x
+    r_e, r_v = vertex_radii(scene, x, system.rest)
+    rep = contact_report(scene.contact, x)
+    values, at = rod_field(color_by, scene, x, system.rest, rep)
+    log.log_rod(f"{name}/rod", x, scene.closed, r_e, values, color_by, field_at=at,
+                radii_at="edge")
+    ia = rep.pairs[:, 0].astype(int)
+    ib = rep.pairs[:, 1].astype(int)
+    log.log_contacts(f"{name}/contacts", x[ia], x[ib], rep.peak_pressure_over_E[ia])
+    if not scene.closed:
+        # The force the pulled end carries (its reaction: the dead load of a force-driven
+        # pull, what holds a moved end where it is otherwise) [N].
+        scalars = {f"{name}/end_to_end": float(np.linalg.norm(x[-1] - x[0])),
+                   f"{name}/pulling_force": end_reaction(system)}
+        lam = lambda_oc(x, scene.diameter, r_v, tol=CONTACT_TOL)
+        if np.isfinite(lam):
+            scalars[f"{name}/lambda_oc"] = lam
+        log.log_scalars(scalars)
+
+
+def logging_hook(log: Any, scene: KnotScene, name: str, counter: list[int],
+                 color_by: str = "kappa_D0", progress: ProgressCallback | None = None,
+                 logged: dict | None = None):
+    """A tie hook that logs each converged load step under ``name/`` on one timeline.
+
+    ``log`` may be None (no logging: only ``progress`` is called). ``logged`` (optional)
+    receives the last logged centerline under ``"x"``, so that the caller can tell whether
+    the final state still needs logging.
+    """
+    check_color_field(color_by)
+
+    def hook(phase: str, system: RodSystem, rec: Any) -> None:
+        step = counter[0]
+        counter[0] += 1
+        if log is not None:
+            log.set_step(step, rec.t)
+            log_state(log, scene, name, system, color_by)
+            sp = system.last_split
+            log.log_scalars({
+                f"{name}/energy/stretch": sp.stretch, f"{name}/energy/bend": sp.bend,
+                f"{name}/energy/twist": sp.twist,
+                f"{name}/energy/contact": float(sum(sp.extra.values())),
+                f"{name}/newton_residual": float(rec.newton.residual),
+                f"{name}/newton_iterations": float(rec.newton.iterations),
+            })
+            if logged is not None:
+                logged["x"] = system.state.x.copy()
+        if progress is not None:
+            progress(phase, rec.t, step)
+    return hook
+
+
+def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactReport) -> dict:
+    """The JSON summary of one knot (the knots issue's keys, NaN-free)."""
+    x = res.system.state.x
+    dmin, _, _ = scene.contact.min_distance(x)
+    s = np.asarray(rep["s"])
+    out: dict[str, Any] = {
+        "scene": scene.name,
+        "converged": res.converged,
+        "failure": res.failure,
+        "knot_type": rep["knot_type"],
+        "alexander_at_minus1": rep["knot_determinant"],
+        "newton_iterations": res.newton_iterations,
+        "wall_time_s": res.wall_time_s,
+        "nodes": scene.model.vertex_count,
+        "diameter_m": scene.diameter,
+        "rest_length_m": scene.rest_length,
+        "stretch": rep["stretch_L_over_L0"],
+        "L_over_D": rep["L_over_D"],
+        # No pair within the interaction range (a knot that came undone): no gap to report
+        # (JSON has no infinity).
+        "min_gap_over_D0": dmin / scene.diameter if math.isfinite(dmin) else None,
+        "max_pressure_over_E": float(np.max(contact.peak_pressure_over_E)),
+        "min_area_ratio": float(np.min(contact.area_ratio)),
+        "max_contact_width_fraction": float(np.max(contact.contact_width_fraction)),
+        "kappa_D0_max": rep["kappa_D0_max"],
+        "kappa_D0_min": rep["kappa_D0_min"],
+        "s": s.tolist(),
+        "kappa": np.asarray(rep["kappa_D0"]).tolist(),
+        "area_ratio": contact.area_ratio.tolist(),
+        "contact_width_fraction": contact.contact_width_fraction.tolist(),
+        "contact_s": np.asarray(rep["contact_s"]).tolist(),
+        "contact_sigma": np.asarray(rep["contact_sigma"]).tolist(),
+        "centerline_m": x.tolist(),
+    }
+    if scene.closed:
+        out["rho"] = np.asarray(rep["rho"]).tolist()
+        out["z"] = np.asarray(rep["z"]).tolist()
+    else:
+        lam = rep.get("Lambda_OC")
+        out["lambda_oc"] = None if lam is None or not np.isfinite(lam) else float(lam)
+        out["pull_force_N"] = float(res.pull_force_N)
+    return out
+
+
+def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
+             counter: list[int] | None = None, *, color_by: str = "kappa_D0",
+             progress: ProgressCallback | None = None, **tie_options: Any) -> KnotRun:
+    """Tie ``scene`` (options of :func:`tightknot.loading.tie.tie`, or ``target_lambda`` for
+    :func:`tightknot.loading.pull.tie_to_lambda`), logging each load step to ``log`` with the
+    tube coloured by ``color_by`` and reporting it to ``progress``.
+
+    The final state is logged as one more step whenever it is not the last logged one (a
+    failed run, whose last attempt did not converge), so the .rrd always ends on the state
+    the summary describes. ``summary["load_steps"]`` counts the converged load steps, each
+    passed to the hook: those of the continuation and, in a pull to a target Lambda_OC,
+    each equilibrium of the force search.
+    """
+    check_color_field(color_by)
+    name = name or scene.name
+    counter = counter if counter is not None else [0]
+    logged: dict = {}
+    # Always hooked: the hook numbers the steps on the timeline and reports progress.
+    inner = logging_hook(log, scene, name, counter, color_by, progress, logged)
+    calls = [0]
+
+    def hook(phase: str, system: RodSystem, rec: Any) -> None:
+        calls[0] += 1
+        inner(phase, system, rec)
+
+    target = tie_options.pop("target_lambda", None)
+    if target is not None:
+        res = tie_to_lambda(scene, target, hook=hook, **tie_options)
+    else:
+        res = tie(scene, hook=hook, **tie_options)
+    x = res.system.state.x
+    if log is not None and not np.array_equal(logged.get("x"), x):
+        log.set_step(counter[0])
+        counter[0] += 1
+        log_state(log, scene, name, res.system, color_by)
+    return measure_run(scene, res, calls[0])
+
+
+def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
+    """The study's measurements of a tied knot (``res``, its final system's state) and its
+    JSON summary, with ``load_steps`` converged load steps (as :func:`run_knot` counts
+    them)."""
+    x = res.system.state.x
+    _, r_v = vertex_radii(scene, x, res.system.rest)
+    # Contact as physics.md sec. 2 defines it for a rod model: distance at most the sum of
+    # the deformed radii; the measurement's 1 % tolerance covers the vertex sampling of the
+    # centerline (segments touch between vertices) and the contact law's onset band.
+    rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
+                             radii=r_v, contact_tol=CONTACT_TOL)
+    contact = contact_report(scene.contact, x, res.system.rest)
+    summary = summarise(scene, res, rep, contact)
+    summary["load_steps"] = load_steps
+    return KnotRun(scene, res, rep, contact, summary)
+
+
+#: Tail shown beyond the knot in an open knot's tube picture, in rest diameters D0.
+TUBE_TAIL_D0 = 1.5
+
+
+def draw_tube(run: KnotRun, path: Path, field: str = "kappa_D0") -> Path:
+    """The final rod of ``run`` as a 3D tube (deformed radii) coloured by ``field``.
+
+    An open knot is drawn from TUBE_TAIL_D0 before its first contact to as far after its
+    last (the long straight tails would shrink the knot to a dot); without contact, whole.
+    """
+    from tightknot.viz.tube_figure import render_tube
+
+    system = run.result.system
+    x = system.state.x
+    _, r_v = vertex_radii(run.scene, x, system.rest)
+    values, at = rod_field(check_color_field(field), run.scene, x, system.rest, run.contact)
+    if not run.scene.closed:
+        touching = np.nonzero(run.contact.contact_width_fraction > 0)[0]
+        if touching.size:
+            s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
+            tail = TUBE_TAIL_D0 * run.scene.diameter
+            i0 = int(np.searchsorted(s, s[touching[0]] - tail))
+            i1 = int(np.searchsorted(s, s[touching[-1]] + tail)) + 1
+            x, r_v = x[i0:i1], r_v[i0:i1]
+            values = values[i0:i1] if at == "vertex" else values[i0:i1 - 1]
+    s = run.summary
+    what = (f"L0/D0 = {run.scene.rest_length / run.scene.diameter:.2f}" if run.scene.closed
+            else f"L0 = {run.scene.rest_length * 1e3:.0f} mm, F = {s['pull_force_N']:.3g} N" + (
+                "" if s.get("lambda_oc") is None else f", Lambda_OC = {s['lambda_oc']:.2f}"))
+    title = f"{run.scene.name.replace('_', ' ')}: {what}, {s['knot_type']}"
+    view = (60.0, -60.0) if run.scene.closed else (70.0, -90.0)
+    return render_tube(path, x, r_v, run.scene.closed, values, field, title, field_at=at,
+                       view=view)
+
+
+def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> list[Path]:
+    """The study's figures of the runs into ``folder`` (created); returns the paths.
+
+    ``tube``: also draw each run's final rod as a tube coloured by this field
+    (``tube_<field>.png``; ``<i>_tube_<field>.png`` for several runs).
+    """
+    # matplotlib only here: importing it costs 1.5-2 s in every fresh sweep worker.
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from tightknot.viz import figures
+
+    folder.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    if tube is not None:
+        for i, r in enumerate(runs):
+            name = f"tube_{tube}.png" if len(runs) == 1 else f"{i}_tube_{tube}.png"
+            paths.append(draw_tube(r, folder / name, tube))
+    closed = [r for r in runs if r.scene.closed]
+    opened = [r for r in runs if not r.scene.closed]
+    if closed:
+        d0 = closed[0].scene.diameter
+        ideal = analyze_centerline(load_ideal_trefoil(d0), d0, True, contact_tol=0.002)
+        for r in closed:
+            p1, p2 = folder / "closed_profiles.png", folder / "closed_contact_map.png"
+            figures.plot_closed_profiles(r.report, p1, ideal=ideal, label="elastic rod")
+            figures.plot_contact_map(r.report, p2, ideal=ideal, label="elastic rod")
+            paths += [p1, p2]
+    if opened:
+        reps, lcs, areas = {}, {}, {}
+        for r in opened:
+            lab = f"L0 = {r.scene.rest_length * 1e3:.0f} mm, F = {r.result.pull_force_N:.3g} N"
+            order = np.asarray(r.report.get("vertex_order", np.arange(len(r.contact.area_ratio))),
+                               dtype=int)
+            reps[lab] = r.report
+            lcs[lab] = r.contact.contact_width_fraction[order]
+            areas[lab] = r.contact.area_ratio[order]
+        p = folder / "open_knots.png"
+        figures.plot_open_knots(reps, p, contact_width=lcs, area_ratio=areas)
+        paths.append(p)
+    return paths
