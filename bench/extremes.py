@@ -45,7 +45,7 @@ def _cases(quick: bool, huge: bool) -> list[tuple[str, Callable[[], C.Outcome]]]
 
         start = time.perf_counter()
         scene = closed_trefoil(16.37, C.D0, 64)
-        res = tie(scene, tighten_steps=40)
+        res = tie(scene, tighten_steps=40).run()
         floor = C.float32_floor(scene, res)
         ok = floor["residual_positions_rounded_to_float32"] > 1e-6
         return C.Outcome("float32 positions of the tied closed trefoil N=64",

@@ -9,7 +9,7 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment
 from tightknot.rods.state import State
-from tightknot.solvers.continuation import ContinuationOptions, solve_static
+from tightknot.solvers.continuation import ContinuationOptions, continuation
 from tightknot.solvers.system import RodSystem
 from tightknot.verification.elastica import cantilever_tip
 
@@ -25,7 +25,7 @@ def main() -> float:
     load = 2.0 * modulus * second_moment(diameter) / length**2  # F L^2/EI = 2
     bcs = BoundaryConditions(model).clamp(0, "start").force(0, -1, [0.0, -load, 0.0])
     system = RodSystem(model, State.initial(model), bcs)
-    result = solve_static(system, ContinuationOptions(steps=4))
+    result = continuation(system, ContinuationOptions(steps=4)).run()
     x_ref, y_ref = cantilever_tip(2.0, length)
     tip = system.state.x[-1]
     err = float(np.hypot(tip[0] - x_ref, tip[1] - y_ref) / length)

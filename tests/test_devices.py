@@ -78,7 +78,7 @@ def test_a_closed_knot_ties_to_the_same_equilibrium() -> None:
     runs = {}
     for dev in ("cpu", CUDA):
         scene = closed_trefoil(l0_over_d0=16.37, nodes=60, device=dev)
-        res = tie(scene, tighten_steps=10)
+        res = tie(scene, tighten_steps=10).run()
         assert res.converged, f"{dev}: {res.failure}"
         assert set(res.knot_types) == {"3_1"}
         runs[dev] = _invariants(res.system.state.x, scene)
@@ -96,7 +96,7 @@ def test_a_batch_on_the_gpu_agrees_with_one_by_one_on_the_cpu() -> None:
     assert batch.converged, batch.failure
     for k, r in enumerate(ratios):
         scene = closed_trefoil(l0_over_d0=r, nodes=60)
-        single = tie(scene, tighten_steps=10)
+        single = tie(scene, tighten_steps=10).run()
         assert single.converged, single.failure
         np.testing.assert_allclose(_invariants(batch.positions[k], scene),
                                    _invariants(single.system.state.x, scene), rtol=0,

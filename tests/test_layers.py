@@ -15,7 +15,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1] / "tightknot"
 
 #: Modules directly under tightknot/ that every layer may use (file output, Warp setup).
-BASE = {"atomic", "warp_setup"}
+BASE = {"atomic", "warp_setup", "_lazy"}
 
 _LOW = {"base", "rods", "contact"}
 #: package -> the packages it may import.

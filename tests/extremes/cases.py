@@ -166,7 +166,7 @@ def run_tie_case(name: str, make_scene: Callable[[], KnotScene], summary: bool =
             run = run_knot(scene, **tie_kw)
             res, outputs = run.result, run.summary
         else:
-            res, outputs = tie(scene, **tie_kw), {}
+            res, outputs = tie(scene, **tie_kw).run(), {}
     except ValueError as err:
         return Outcome(name, "rejected", str(err), time.perf_counter() - start,
                        expected_type=scene.knot_type)
@@ -300,7 +300,7 @@ def dynamics(dt: float, steps: int = 3, nodes: int = 48, speed: float = 0.05,
 def tied_closed_trefoil(nodes: int = 48) -> tuple[KnotScene, Any]:
     """A closed trefoil scene (L0/D0 = 16.37) and its tied state (velocities zero)."""
     scene = closed_trefoil(16.37, D0, nodes)
-    res = tie(scene, tighten_steps=40)
+    res = tie(scene, tighten_steps=40).run()
     if not res.converged:
         raise RuntimeError(f"tying the closed trefoil failed: {res.failure}")
     state = res.system.state.copy()

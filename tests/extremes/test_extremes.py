@@ -251,7 +251,7 @@ def test_float32_positions_cannot_hold_the_tolerance() -> None:
     from tightknot.loading.tie import tie
 
     scene = closed_trefoil(16.37, C.D0, 64)
-    res = tie(scene, tighten_steps=40)
+    res = tie(scene, tighten_steps=40).run()
     assert res.converged, res.failure
     floor = C.float32_floor(scene, res)
     assert floor["residual_float64"] <= 1e-6

@@ -70,7 +70,7 @@ def test_closed_figure_eight_ties_and_keeps_its_type() -> None:
     scene = closed_figure_eight(nodes=80)  # L0/D0 = 22.1, 5 % above the ideal 21.04
     assert scene.knot_type == "4_1"
     assert scene.start_length_ratio > 1.2  # a loose start, tightened by the mechanics
-    res = tie(scene, tighten_steps=40)
+    res = tie(scene, tighten_steps=40).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"4_1"}
     x = res.system.state.x
@@ -92,7 +92,7 @@ def test_closed_figure_eight_ties_and_keeps_its_type() -> None:
 def test_open_figure_eight_pulled_by_a_modest_force_keeps_its_type() -> None:
     # 2 N ~ 0.45 EI/D0^2: a modest pull (the study's open trefoils took 1.8 and 6.1 N).
     scene = open_figure_eight(nodes=100)  # L0 = 0.30 m
-    res = tie(scene, pull_force=2.0, tighten_steps=40, pull_steps=10)
+    res = tie(scene, pull_force=2.0, tighten_steps=40, pull_steps=10).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"4_1"}
     x = res.system.state.x
@@ -110,7 +110,7 @@ def test_rigid_tube_level_keeps_the_diameter_on_a_closed_trefoil() -> None:
     # polygon lets segments pass closer between them: measured 0.936 D0 at 40 vertices),
     # L0/D0 = 20 (looser than the ideal 16.37, so the stiff tube closes in few steps).
     scene = closed_trefoil(20.0, nodes=64, contact="rigid")
-    res = tie(scene, tighten_steps=20)
+    res = tie(scene, tighten_steps=20).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     dmin, _, _ = scene.contact.min_distance(res.system.state.x)
@@ -129,7 +129,7 @@ def test_twist_off_gives_the_shape_of_twist_on_for_an_isotropic_closed_knot() ->
     shapes = {}
     for twist in (True, False):
         scene = closed_trefoil(nodes=48, twist=twist)
-        res = tie(scene, tighten_steps=40)
+        res = tie(scene, tighten_steps=40).run()
         assert res.converged, res.failure
         assert set(res.knot_types) == {"3_1"}
         shapes[twist] = (scene, res.system.state.x)
@@ -154,7 +154,7 @@ def test_smoothed_level_ties_the_same_closed_trefoil() -> None:
     for level in ("compliant", "smoothed"):
         scene = closed_trefoil(nodes=48, contact=level)
         assert scene.info["model"]["contact"] == level
-        res = tie(scene)
+        res = tie(scene).run()
         assert res.converged, res.failure
         assert set(res.knot_types) == {"3_1"}
         x = res.system.state.x

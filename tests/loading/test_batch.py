@@ -43,7 +43,7 @@ def test_batch_agrees_with_one_by_one():
     singles = []
     for k, (r, x_b) in enumerate(zip(RATIOS, batch.positions, strict=True)):
         scene = closed_trefoil(l0_over_d0=r, nodes=NODES)
-        single = tie(scene)
+        single = tie(scene).run()
         assert single.converged, single.failure
         singles.append(single)
         # Each rod's own system evaluates on its own (its scene's contact layer).
@@ -90,7 +90,7 @@ def test_joint_evaluation_equals_one_rod():
     """Energy parts, gradient and Hessian of a tight knot, asked of the batch evaluator,
     equal those of its own RodSystem (contact included)."""
     scene = closed_trefoil(l0_over_d0=17.0, nodes=NODES)
-    single = tie(scene).system
+    single = tie(scene).run().system
     st = single.state
     scenes = [closed_trefoil(l0_over_d0=r, nodes=NODES) for r in (17.0, 19.0)]
     joint = build_batch(scenes)

@@ -16,7 +16,7 @@ def _length(x: np.ndarray, closed: bool) -> float:
 
 def test_closed_trefoil_ties_and_stretches() -> None:
     scene = closed_trefoil(nodes=100)
-    res = tie(scene, tighten_steps=40)
+    res = tie(scene, tighten_steps=40).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     x = res.system.state.x
@@ -36,7 +36,8 @@ def test_open_trefoil_tightens_and_a_harder_pull_makes_it_shorter() -> None:
     lams: list[float] = []
     res = tie(scene, pull_force=5.0, tighten_steps=40, pull_steps=10,
               hook=lambda phase, sys_, rec: lams.append(
-                  lambda_oc(sys_.state.x, scene.diameter, tol=0.0)) if phase == "pull" else None)
+                  lambda_oc(sys_.state.x, scene.diameter, tol=0.0)) if phase == "pull" else None
+              ).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     x = res.system.state.x
@@ -82,7 +83,7 @@ def test_the_study_open_knots_reach_their_target_lengths() -> None:
     forces = []
     for length, target, nodes in ((0.185, 15.0, 150), (0.125, 10.1, 100)):
         scene = open_trefoil(rest_length=length, nodes=nodes)
-        res = tie_to_lambda(scene, target)
+        res = tie_to_lambda(scene, target).run()
         assert res.converged, res.failure
         assert set(res.knot_types) == {"3_1"}
         x = res.system.state.x
@@ -111,7 +112,7 @@ def test_a_hard_pull_keeps_the_knot_and_its_tube(contact: str) -> None:
         return sc
 
     first = make()
-    tight = tie(first)
+    tight = tie(first).run()
     assert tight.converged, tight.failure
     f_t = end_reaction(tight.system)
     scene = make()
@@ -121,7 +122,7 @@ def test_a_hard_pull_keeps_the_knot_and_its_tube(contact: str) -> None:
         if phase == "pull":
             gaps.append(scene.contact.min_distance(system.state.x)[0] / scene.diameter)
 
-    res = tie(scene, pull_force=3.0 * f_t, hook=hook)
+    res = tie(scene, pull_force=3.0 * f_t, hook=hook).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     assert len(gaps) >= 5

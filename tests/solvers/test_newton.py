@@ -9,9 +9,9 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment
 from tightknot.rods.state import State
-from tightknot.solvers.continuation import ContinuationOptions, solve_static
+from tightknot.solvers.continuation import ContinuationOptions, continuation
 from tightknot.solvers.linear import factorize
-from tightknot.solvers.newton import NewtonOptions, newton_solve
+from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.pattern import SparsePattern
 from tightknot.solvers.system import RodSystem
 
@@ -30,7 +30,7 @@ def test_non_convergence_is_reported_not_nan() -> None:
     system = _cantilever()
     system.set_load(1.0)
     # Two iterations cannot reach a large-deflection equilibrium from the straight rod.
-    res = newton_solve(system, system.free_vector(), NewtonOptions(max_iterations=2))
+    res = newton(system, system.free_vector(), NewtonOptions(max_iterations=2)).run()
     assert not res.converged
     assert res.reason == "max_iterations"
     assert math.isfinite(res.residual) and res.residual > 1e-8
@@ -39,7 +39,7 @@ def test_non_convergence_is_reported_not_nan() -> None:
 
 def test_converges_quadratically_near_solution() -> None:
     system = _cantilever(load_parameter=1.0)
-    res = solve_static(system, ContinuationOptions(steps=4))
+    res = continuation(system, ContinuationOptions(steps=4)).run()
     assert res.converged
     hist = res.steps[-1].newton.history
     # Quadratic convergence: once the residual is below 1e-2, the next is below its square
@@ -53,7 +53,7 @@ def test_converges_quadratically_near_solution() -> None:
 def test_failed_continuation_restores_last_equilibrium() -> None:
     system = _cantilever(load_parameter=3.0)
     opts = ContinuationOptions(steps=1, min_step=0.5, newton=NewtonOptions(max_iterations=1))
-    res = solve_static(system, opts)
+    res = continuation(system, opts).run()
     assert not res.converged
     assert "min_step" in res.failure and "t=" in res.failure
     assert np.isfinite(system.state.x).all()
@@ -84,50 +84,41 @@ def test_pattern_drops_fixed_dofs() -> None:
     assert (pat.diag_slot >= 0).all()
 
 
-class _Deferred:
-    """A problem of the generator solvers whose evaluations are questions (yielded) that
-    the test answers, as the batch of rods does."""
-
-    def __init__(self, system: RodSystem) -> None:
-        from tightknot.solvers.dynamic import ImmediateSystem
-
-        self._now = ImmediateSystem(system)
-        self.asked = 0
-
-    def __getattr__(self, name: str):  # noqa: ANN204 (everything else: answered at once)
-        return getattr(self._now, name)
-
-    def evaluate(self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True):
-        self.asked += 1
-        answer = yield ("evaluate", u, want_grad, want_hess)
-        return answer
-
-
 def test_a_question_answered_later_gives_the_same_solve() -> None:
-    from tightknot.solvers.continuation import continuation_gen
+    # A program's questions may be answered whenever its driver likes (a batch collects
+    # them): answered one by one from outside, the continuation is the same to the bit.
+    from tightknot.solvers.program import Evaluate
 
     direct = _cantilever(load_parameter=1.0)
-    ref = solve_static(direct, ContinuationOptions(steps=4))
+    ref = continuation(direct, ContinuationOptions(steps=4)).run()
     system = _cantilever(load_parameter=1.0)
-    p = _Deferred(system)
-    gen = continuation_gen(p, ContinuationOptions(steps=4))
-    question = next(gen)
+    gen = iter(continuation(system, ContinuationOptions(steps=4)))
+    asked = 0
+    answer = None
     while True:
-        _, u, wg, wh = question
         try:
-            question = gen.send(system.evaluate(u, wg, wh))
+            question = gen.send(answer)
         except StopIteration as done:
             res = done.value
             break
-    assert p.asked > 0
+        assert question.system is system
+        asked += isinstance(question, Evaluate)
+        answer = question.answer()
+    assert asked > 0
     assert res.converged and res.newton_iterations == ref.newton_iterations
     np.testing.assert_array_equal(system.state.x, direct.state.x)
 
 
-def test_run_now_refuses_a_question() -> None:
-    from tightknot.solvers.newton import newton_gen, run_now
-
+def test_a_program_says_it_was_not_run() -> None:
     system = _cantilever()
-    system.set_load(1.0)
-    with pytest.raises(RuntimeError, match="cannot answer"):
-        run_now(newton_gen(_Deferred(system), system.free_vector()))
+    prog = continuation(system, ContinuationOptions(steps=4))
+    with pytest.raises(AttributeError, match=r"call \.run\(\)"):
+        _ = prog.converged
+    assert prog.run().converged
+
+
+def test_a_batch_rod_is_not_evaluated_alone() -> None:
+    system = _cantilever()
+    system.batch = object()  # attached to some batch: only the batch answers it
+    with pytest.raises(RuntimeError, match="answered by the batch"):
+        system.evaluate(system.free_vector())

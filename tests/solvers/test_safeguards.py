@@ -13,8 +13,9 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment
 from tightknot.rods.state import State
-from tightknot.solvers.continuation import ContinuationOptions, solve_static
-from tightknot.solvers.newton import NewtonOptions, newton_solve
+from tightknot.solvers.continuation import ContinuationOptions, continuation
+from tightknot.solvers.linear import SparseDirect
+from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.system import RodSystem
 
 
@@ -22,9 +23,14 @@ class _Blocked:
     """E = |u - 1|^2 / 2 whose every step is blocked to a 1e-14 fraction (as a contact
     layer blocks steps that would pass through): no progress is possible."""
 
+    linear = SparseDirect()
+
     def __init__(self, n: int = 3) -> None:
         self.target = np.ones(n)
         self.accepted = 0
+
+    def has_trial(self, u):
+        return True  # accept needs no evaluation of its own
 
     def evaluate(self, u, want_grad=True, want_hess=True):
         import scipy.sparse as sp
@@ -52,8 +58,8 @@ def test_no_progress_stops_as_stalled_within_the_window() -> None:
     prob = _Blocked()
     # step_tol is set out of reach so that only the no-progress test can end the loop early
     # (the blocked steps shrink, which the step-size test would otherwise catch).
-    res = newton_solve(prob, np.zeros(3), NewtonOptions(max_iterations=500, step_tol=1e-300,
-                                                        stall_iterations=40))
+    res = newton(prob, np.zeros(3), NewtonOptions(max_iterations=500, step_tol=1e-300,
+                                                  stall_iterations=40)).run()
     assert not res.converged
     assert res.reason == "stalled"
     # It stops as soon as 40 iterations (the window) made no progress over the start, not at
@@ -63,8 +69,8 @@ def test_no_progress_stops_as_stalled_within_the_window() -> None:
 
 
 def test_stall_test_can_be_turned_off() -> None:
-    res = newton_solve(_Blocked(), np.zeros(3), NewtonOptions(
-        max_iterations=60, step_tol=1e-300, stall_iterations=0))
+    res = newton(_Blocked(), np.zeros(3), NewtonOptions(
+        max_iterations=60, step_tol=1e-300, stall_iterations=0)).run()
     assert res.reason == "max_iterations" and res.iterations == 60
 
 
@@ -97,7 +103,7 @@ def _cantilever(n: int = 30, load_parameter: float = 5.0) -> RodSystem:
 def test_failure_names_the_load_step_and_keeps_the_failing_iterate() -> None:
     system = _cantilever(load_parameter=3.0)
     opts = ContinuationOptions(steps=4, min_step=0.2, newton=NewtonOptions(max_iterations=2))
-    res = solve_static(system, opts)
+    res = continuation(system, opts).run()
     assert not res.converged
     assert "load step 1 (from t=0 to t=" in res.failure, res.failure
     # The system is back at the last equilibrium (here the start), the failing iterate is
@@ -109,15 +115,15 @@ def test_failure_names_the_load_step_and_keeps_the_failing_iterate() -> None:
 
 def test_callback_refusal_names_the_load_step() -> None:
     system = _cantilever(load_parameter=1.0)
-    res = solve_static(system, ContinuationOptions(steps=4),
-                       callback=lambda s, rec: "refused" if rec.t > 0.4 else None)
+    res = continuation(system, ContinuationOptions(steps=4),
+                       callback=lambda s, rec: "refused" if rec.t > 0.4 else None).run()
     assert not res.converged
     assert res.failure.startswith("refused [load step 2 (from t=0.25 to t=0.5)]"), res.failure
 
 
 def test_newton_budget_stops_the_path() -> None:
     system = _cantilever(load_parameter=5.0)
-    res = solve_static(system, ContinuationOptions(steps=20, max_newton_iterations=10))
+    res = continuation(system, ContinuationOptions(steps=20, max_newton_iterations=10)).run()
     assert not res.converged
     assert "budget of 10 iterations" in res.failure and "load step" in res.failure
     assert res.newton_iterations >= 10 and res.t < 1.0
@@ -129,7 +135,7 @@ def test_steps_halve_on_failure_and_grow_after_easy_ones() -> None:
     # until steps converge, then grows them again after easy steps.
     system = _cantilever(load_parameter=5.0)
     opts = ContinuationOptions(steps=1, grow_below=8, newton=NewtonOptions(max_iterations=8))
-    res = solve_static(system, opts)
+    res = continuation(system, opts).run()
     assert res.converged, res.failure
     dts = np.diff([0.0] + [r.t for r in res.steps])
     assert dts.max() < 1.0  # the first full step was halved

@@ -26,7 +26,7 @@ from tightknot.loading.batch import BatchResult, tie_batch
 from tightknot.loading.tie import tie
 from tightknot.solvers.banded import single_blas_thread
 from tightknot.solvers.batch_eval import EvalRequest
-from tightknot.solvers.lockstep import RodProblem
+from tightknot.solvers.lockstep import BandedSolver, LinearStats
 from tightknot.solvers.system import RodSystem
 
 #: The issue's target: 64 trefoils of 100 vertices batched >= 5x faster than sequential.
@@ -35,7 +35,7 @@ TARGET_SPEEDUP = 5.0
 
 def _iteration_parts(system: RodSystem, repeats: int = 9) -> dict[str, float]:
     """Median times [s] of one evaluation with Hessian and one factorization + solve of a
-    one-rod system (as :func:`tightknot.solvers.newton.newton_solve` does them)."""
+    one-rod system (as :func:`tightknot.solvers.newton.newton` does them)."""
     evaluate_s, solve_s = newton_iteration_parts(system, repeats)
     return {"evaluate_s": evaluate_s, "factorize_solve_s": solve_s}
 
@@ -46,7 +46,7 @@ def _batched_parts(batch: BatchResult, repeats: int = 9) -> dict[str, float]:
     ev = batch.evaluator
     systems = [o.system for o in batch.rods]
     n = len(systems)
-    problems = [RodProblem(k, s, ev) for k, s in enumerate(systems)]
+    solvers = [BandedSolver(LinearStats()) for _ in systems]
     te, tf = [], []
     with single_blas_thread():
         for rep in range(repeats + 1):
@@ -55,10 +55,10 @@ def _batched_parts(batch: BatchResult, repeats: int = 9) -> dict[str, float]:
             t0 = time.perf_counter()
             answers = ev.evaluate(reqs)
             t1 = time.perf_counter()
-            for k, p in enumerate(problems):
+            for k, (s, solver) in enumerate(zip(systems, solvers, strict=True)):
                 ans = answers[k]
-                p.shifted_direction(ans.hess, ans.grad[p.system.pattern.free_dofs], 0.0,
-                                    np.abs(ans.hess.data[ans.hess.diag_slot]))
+                solver.shifted_direction(ans.hess, ans.grad[s.pattern.free_dofs], 0.0,
+                                         np.abs(ans.hess.data[ans.hess.diag_slot]))
             t2 = time.perf_counter()
             if rep:  # the first builds each rod's ordering (once per contact pattern)
                 te.append((t1 - t0) / n)
@@ -99,7 +99,7 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
               for r in ratios]
     # Warm up both paths on one small case (kernel modules loaded, tables cached), so that
     # neither pays a one-time cost inside its timing.
-    tie(closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device))
+    tie(closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device)).run()
     tie_batch([closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device)])
     t0 = time.perf_counter()
     batch = tie_batch(scenes, residual_tol=residual_tol)
@@ -119,7 +119,7 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
         for k in pick:
             scene = closed_trefoil(l0_over_d0=float(ratios[k]), nodes=nodes, device=device)
             t0 = time.perf_counter()
-            single = tie(scene, residual_tol=residual_tol)
+            single = tie(scene, residual_tol=residual_tol).run()
             ts += time.perf_counter() - t0
             if not single.converged:
                 raise RuntimeError(f"sequential tie of case {k} failed: {single.failure}")

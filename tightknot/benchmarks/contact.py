@@ -107,14 +107,14 @@ def run(vertices: int = 300, repeats: int = 30, device: str = "cpu") -> dict:
     from tightknot.knots.open_measures import lambda_oc
     from tightknot.knots.scenes import open_trefoil
     from tightknot.loading.tie import tie
-    from tightknot.solvers.continuation import ContinuationOptions, solve_static
+    from tightknot.solvers.continuation import ContinuationOptions, continuation
     from tightknot.solvers.linear import factorize
 
     if vertices < 60:
         raise ValueError(f"vertices must be >= 60 (a trefoil of 125 mm), got {vertices}")
     scene = open_trefoil(SCENE["rest_length_m"], nodes=vertices, device=device)
     t0 = time.perf_counter()
-    res = tie(scene, pull_force=SCENE["pull_force_N"])
+    res = tie(scene, pull_force=SCENE["pull_force_N"]).run()
     tie_s = time.perf_counter() - t0
     if not res.converged:
         raise RuntimeError(f"the benchmark scene did not converge: {res.failure}")
@@ -143,7 +143,7 @@ def run(vertices: int = 300, repeats: int = 30, device: str = "cpu") -> dict:
     timer = _Timed(scene.contact)
     try:
         t1 = time.perf_counter()
-        sol = solve_static(again, ContinuationOptions(steps=1))
+        sol = continuation(again, ContinuationOptions(steps=1)).run()
         solve_wall = time.perf_counter() - t1
     finally:
         timer.remove()

@@ -48,7 +48,7 @@ def iteration_time(n: int, repeats: int = 5, device: str = "cpu") -> dict:
 
 def newton_iteration_parts(system: RodSystem, repeats: int) -> tuple[float, float]:
     """Median times [s] of the two parts of one Newton iteration at the system's state,
-    as :func:`tightknot.solvers.newton.newton_solve` does them: the evaluation with
+    as :func:`tightknot.solvers.newton.newton` does them: the evaluation with
     Hessian, and the factorization + solve."""
     u = system.free_vector()
     ta, ts = [], []

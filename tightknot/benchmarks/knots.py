@@ -48,8 +48,8 @@ def _phases(res: Any) -> dict:
 def warm_up(device: str = "cpu") -> float:
     """Tie a small closed and a small open trefoil (kernels loaded or compiled); seconds."""
     t0 = time.perf_counter()
-    tie(closed_trefoil(nodes=40, device=device), tighten_steps=5)
-    tie(open_trefoil(nodes=90, device=device), tighten_steps=5)
+    tie(closed_trefoil(nodes=40, device=device), tighten_steps=5).run()
+    tie(open_trefoil(nodes=90, device=device), tighten_steps=5).run()
     return time.perf_counter() - t0
 
 
@@ -59,7 +59,7 @@ def closed_case(nodes: int = 200, device: str = "cpu") -> dict:
     stretch equal to 1e-6, max kappa*D0 to 3e-5) in twice the Newton iterations."""
     scene = closed_trefoil(16.37, nodes=nodes, device=device)
     t0, c0 = time.perf_counter(), time.process_time()
-    res = tie(scene)
+    res = tie(scene).run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     x = res.system.state.x
     return {"case": "closed_trefoil", "vertices": nodes, "l0_over_d0": 16.37,
@@ -75,7 +75,7 @@ def open_case(nodes: int = 300, length: float = 0.185, target: float = 10.1,
     """The open trefoil of ``length`` pulled to Lambda_OC = ``target``."""
     scene = open_trefoil(length, nodes=nodes, device=device)
     t0, c0 = time.perf_counter(), time.process_time()
-    res = tie_to_lambda(scene, target)
+    res = tie_to_lambda(scene, target).run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     x = res.system.state.x
     lam = lambda_oc(x, scene.diameter, vertex_radii(scene, x, res.system.rest)[1])

@@ -75,7 +75,7 @@ def run(levels: int = DEFAULT_LEVELS, nodes: int = DEFAULT_NODES,
 
         scene = build_scene(tight.params)
         t0 = time.perf_counter()
-        ttl = tie_to_lambda(scene, case.levels[-1])
+        ttl = tie_to_lambda(scene, case.levels[-1]).run()
         extra = {"tie_to_lambda_s": time.perf_counter() - t0,
                  "tie_to_lambda_converged": ttl.converged,
                  "tie_to_lambda_force_N": ttl.pull_force_N}

@@ -59,7 +59,7 @@ def _solve_levels(system: Any, path: _Path, levels: list[float],
     the linear extrapolation (in the load value) of the last two equilibria (measured:
     26 instead of 29 iterations over the wrap's 6 levels, 29 either way on the indent's
     10); a failed solve retries smaller steps from the last equilibrium without it."""
-    from tightknot.solvers.continuation import ContinuationOptions, solve_static
+    from tightknot.solvers.continuation import ContinuationOptions, continuation
 
     rows = []
     history: list[tuple[float, np.ndarray]] = []
@@ -75,7 +75,7 @@ def _solve_levels(system: Any, path: _Path, levels: list[float],
                 if t == 0.0 and t_next == 1.0:  # the whole level in one step only
                     sys_.accept(guess)
 
-        result = solve_static(system, ContinuationOptions(steps=1), predictor=predictor)
+        result = continuation(system, ContinuationOptions(steps=1), predictor=predictor).run()
         history.append((value, system.free_vector()))
         row = measure(value)
         row["converged"] = bool(result.converged)

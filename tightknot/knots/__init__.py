@@ -1,4 +1,5 @@
-"""tightknot.knots: knot curves, topology and the measurements of Johanns et al. 2021.
+"""tightknot.knots: knot curves, topology, the study's scenes and the measurements of
+Johanns et al. 2021.
 
 Pure functions of numpy arrays (SI units inside; non-dimensional numbers only in measurement
 outputs, named so). Modules:
@@ -32,3 +33,23 @@ Y_over_D0, origin_S, axis, barycenter, inplane_spread_ratio, outer_segments_s,
 inner_segments_s, double_contact_fraction. Open (arrays in vertex order): Lambda_OC,
 contact_S1, contact_S2, S_mid.
 """
+
+from tightknot._lazy import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "analyze_centerline": ".measure",
+    "read_centerline": ".centerline_io",
+    "write_centerline_csv": ".centerline_io",
+    "CenterlineError": ".centerline_io",
+    "knot_type": ".topology",
+    "alexander_polynomial": ".topology",
+    "bergou_curvature": ".curvature",
+    "study_smooth": ".smoothing",
+    "lambda_oc": ".open_measures",
+    "load_ideal_trefoil": ".ideal",
+    "KnotScene": ".scenes",
+    "closed_trefoil": ".scenes",
+    "open_trefoil": ".scenes",
+    "closed_figure_eight": ".scenes",
+    "open_figure_eight": ".scenes",
+})

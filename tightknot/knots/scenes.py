@@ -45,7 +45,7 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   self-contact entirely, so the rod may pass through itself: only for shapes without
   contact (a loose start, the elastic cost alone in benchmarks); :func:`tightknot.loading.tie.tie`
   needs a contact layer to tie a knot.
-* Inertia is not a scene property: the static solvers (``solve_static``, ``newton_solve``)
+* Inertia is not a scene property: the static solvers (``continuation``, ``newton``)
   neglect it, the dynamic ones (``tightknot.solvers.dynamic``: implicit Euler, proximal
   steps) add the lumped masses of ``Material.density``. Gravity is not modelled by the
   scenes (negligible for these rods, physics.md sec. 1).

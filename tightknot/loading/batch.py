@@ -44,7 +44,7 @@ import numpy as np
 
 from tightknot.contact.layer import ContactLayer
 from tightknot.knots.scenes import KnotScene, gauge
-from tightknot.loading.tie import TieResult, knot_type_of, tie_gen
+from tightknot.loading.tie import TieResult, knot_type_of, tie
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.model import Model
 from tightknot.solvers.banded import single_blas_thread
@@ -55,12 +55,13 @@ from tightknot.solvers.batch_eval import (
 )
 from tightknot.solvers.continuation import StaticResult
 from tightknot.solvers.lockstep import (
+    BatchRod,
     LinearStats,
     LockstepStats,
-    RodProblem,
     run_lockstep,
 )
 from tightknot.solvers.pattern import SparsePattern
+from tightknot.solvers.program import Coroutine
 from tightknot.solvers.system import RodSystem
 
 #: Gap between the bounding boxes of two copies, in rest diameters: far beyond the
@@ -212,17 +213,12 @@ def build_batch(scenes: list[KnotScene]) -> BatchModel:
 
 
 def _tie_program(k: int, scene: KnotScene, evaluator: BatchEvaluator, tighten_steps: int,
-                 residual_tol: float, relax_iterations: int):
-    """:func:`tightknot.loading.tie.tie` of the closed knot ``scene`` as rod ``k`` of the batch
-    (generator): tie's own program (:func:`tightknot.loading.tie.tie_gen`), whose systems are
-    answered by the batch's evaluator, from a copy of the scene's state."""
+                 residual_tol: float, relax_iterations: int) -> Coroutine[RodOutcome]:
+    """:func:`tightknot.loading.tie.tie` of the closed knot ``scene`` as rod ``k`` of the
+    batch: tie's own program, its systems attached to the batch's evaluator, from a copy of
+    the scene's state."""
     check_s = [0.0]
-    stats = LinearStats()
-
-    def problem(system: RodSystem) -> RodProblem:
-        p = RodProblem(k, system, evaluator)
-        p.stats = stats  # one record of the rod's factorizations over its phases
-        return p
+    rod = BatchRod(k, evaluator)
 
     def timed_knot_type(sc: KnotScene, x: np.ndarray) -> str:
         t0 = time.perf_counter()
@@ -231,10 +227,12 @@ def _tie_program(k: int, scene: KnotScene, evaluator: BatchEvaluator, tighten_st
         finally:
             check_s[0] += time.perf_counter() - t0
 
-    res = yield from tie_gen(scene, tighten_steps=tighten_steps, residual_tol=residual_tol,
-                             relax_iterations=relax_iterations, problem=problem,
-                             start_state=scene.state.copy(), knot_type=timed_knot_type)
-    return RodOutcome(res, stats, check_s[0])
+    res = yield from tie(scene, tighten_steps=tighten_steps, residual_tol=residual_tol,
+                         relax_iterations=relax_iterations, attach=rod.attach,
+                         start_state=scene.state.copy(), knot_type=timed_knot_type)
+    if res.system is not None:
+        rod.detach(res.system)  # the result's system evaluates on its own
+    return RodOutcome(res, rod.stats, check_s[0])
 
 
 def tie_batch(

@@ -16,7 +16,9 @@ from tightknot.knots.scenes import (
 from tightknot.loading.recentre import recentre_system
 from tightknot.loading.tie import StepHook, TieResult, end_reaction, knot_type_of, tie
 from tightknot.solvers.continuation import StepRecord
-from tightknot.solvers.newton import NewtonOptions, newton_solve
+from tightknot.solvers.dynamic import proximal
+from tightknot.solvers.newton import NewtonOptions, newton
+from tightknot.solvers.program import Coroutine, Program
 from tightknot.solvers.system import RodSystem
 
 
@@ -28,21 +30,29 @@ def tie_to_lambda(
     max_force_steps: int = 60,
     residual_tol: float = 1e-6,
     hook: StepHook | None = None,
-) -> TieResult:
-    """Tie an open knot, then pull until Lambda_OC = ``target`` within ``tolerance``.
+) -> Program[TieResult]:
+    """Tie an open knot, then pull until Lambda_OC = ``target`` within ``tolerance``; a
+    program (:mod:`tightknot.solvers.program`): ``.run()`` returns the
+    :class:`~tightknot.loading.tie.TieResult`.
 
     After the tightening, the pulling force is stepped geometrically by ``force_ratio``
     (up when the knot is longer than the target, down when shorter; Lambda_OC falls as the
     force grows), then bisected on the force once the target is bracketed. Each force is a
     static Newton solve from the last equilibrium (proximal steps where it fails).
     """
-    from tightknot.solvers.dynamic import proximal_relax
-
     if scene.closed:
         raise ValueError("tie_to_lambda is for open knots")
     if not (math.isfinite(target) and target > 0):
         raise ValueError(f"target Lambda_OC must be finite and > 0, got {target!r}")
-    res = tie(scene, tighten_steps=40, residual_tol=residual_tol, hook=hook)
+    return Program(_tie_to_lambda(scene, target, tolerance, force_ratio, max_force_steps,
+                                  residual_tol, hook), "tie_to_lambda")
+
+
+def _tie_to_lambda(scene: KnotScene, target: float, tolerance: float, force_ratio: float,
+                   max_force_steps: int, residual_tol: float,
+                   hook: StepHook | None) -> Coroutine[TieResult]:
+    """The coroutine of :func:`tie_to_lambda` (its arguments checked)."""
+    res = yield from tie(scene, tighten_steps=40, residual_tol=residual_tol, hook=hook)
     if not res.converged:
         return res
     start = time.perf_counter()
@@ -60,17 +70,17 @@ def tie_to_lambda(
     iters = res.newton_iterations
     types = list(res.knot_types)
 
-    def solve_at(f: float) -> tuple[bool, float, str]:
+    def solve_at(f: float) -> Coroutine[tuple[bool, float, str]]:
         nonlocal iters
         recentre_system(scene, pull)  # each force starts from the knot centred on its rod
         saved = pull.state.copy()
         saved_force = force[0]
         force[0] = f
         pull.set_load(1.0)
-        r = newton_solve(pull, pull.free_vector(), opts)
+        r = yield from newton(pull, pull.free_vector(), opts)
         iters += r.iterations
         if not r.converged:
-            prox = proximal_relax(pull, 1e-3, 200, opts)
+            prox = yield from proximal(pull, 1e-3, 200, opts)
             iters += prox.newton_iterations
             if not prox.converged:
                 pull.state = saved
@@ -93,7 +103,7 @@ def tie_to_lambda(
         return TieResult(ok, msg, res.phases, iters, res.wall_time_s + time.perf_counter()
                          - start, types, force[0], pull)
 
-    ok, lam, msg = solve_at(force[0])
+    ok, lam, msg = yield from solve_at(force[0])
     if not ok:
         return done(False, f"pull: {msg}")
     if abs(lam - target) <= tolerance:
@@ -103,7 +113,7 @@ def tie_to_lambda(
     ratio = force_ratio
     for _ in range(max_force_steps):
         f = f_prev * (ratio if up else 1.0 / ratio)
-        ok, lam, msg = solve_at(f)
+        ok, lam, msg = yield from solve_at(f)
         if not ok and ratio > force_ratio ** 0.125:
             # A failed force step (Newton, or the knot slipping off a tail while it
             # loosens) is retried from the last equilibrium with half the step in log
@@ -126,7 +136,7 @@ def tie_to_lambda(
     state_hi = pull.state.copy()
     for _ in range(30):
         mid = math.sqrt(lo * hi)
-        ok, lam, msg = solve_at(mid)
+        ok, lam, msg = yield from solve_at(mid)
         if not ok:
             return done(False, f"bisection toward Lambda_OC = {target:g}: {msg}")
         if abs(lam - target) <= tolerance:

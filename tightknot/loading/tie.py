@@ -24,7 +24,6 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -41,10 +40,10 @@ from tightknot.solvers.continuation import (
     ContinuationOptions,
     StaticResult,
     StepRecord,
-    continuation_gen,
+    continuation,
 )
-from tightknot.solvers.dynamic import ImmediateSystem
-from tightknot.solvers.newton import NewtonOptions, newton_gen, run_now
+from tightknot.solvers.newton import NewtonOptions, newton
+from tightknot.solvers.program import Coroutine, Program
 from tightknot.solvers.system import RodSystem
 
 StepHook = Callable[[str, RodSystem, StepRecord], None]
@@ -104,6 +103,14 @@ def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | No
     return check
 
 
+def _attached(system: RodSystem, attach: Callable[[RodSystem], None] | None) -> RodSystem:
+    """``system`` handed to ``attach`` (a batch), at the start of its load path."""
+    if attach is not None:
+        attach(system)
+    system.set_load(0.0)
+    return system
+
+
 def _opts(steps: int, tol: float) -> ContinuationOptions:
     # Knots have limit points along their paths (a loop that flips, a tail that slides
     # through): proximal steps carry the solve through them (proximal_dt).
@@ -122,8 +129,13 @@ def tie(
     hold_force_scale: float = 0.05,
     relax_iterations: int = 2000,
     hook: StepHook | None = None,
-) -> TieResult:
-    """Tie ``scene``: shrink its rest length to L0, then (open knots) pull.
+    attach: Callable[[RodSystem], None] | None = None,
+    start_state: State | None = None,
+    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
+) -> Program[TieResult]:
+    """Tie ``scene``: shrink its rest length to L0, then (open knots) pull. A program
+    (:mod:`tightknot.solvers.program`): ``tie(scene).run()`` returns the
+    :class:`TieResult`; a batch runs many together (:mod:`tightknot.loading.batch`).
 
     Args:
         pull_force: final pulling force [N] (open knots).
@@ -133,30 +145,11 @@ def tie(
         hold_force_scale: tension on a sliding end while tightening, over EI/D0^2.
         relax_iterations: Newton budget of the relaxation of the start curve.
         hook: called after each converged step with (phase, system, record).
+        attach: called with each phase's system before it is solved (a batch attaches
+            it, :class:`tightknot.solvers.lockstep.BatchRod`).
+        start_state: where to start (default: the scene's state).
+        knot_type: the knot type of a centerline (default :func:`knot_type_of`).
     """
-    return run_now(tie_gen(scene, pull_force, end_distance, tighten_steps, pull_steps,
-                           residual_tol, hold_force_scale, relax_iterations, hook))
-
-
-def tie_gen(
-    scene: KnotScene,
-    pull_force: float | None = None,
-    end_distance: float | None = None,
-    tighten_steps: int = 20,
-    pull_steps: int = 20,
-    residual_tol: float = 1e-6,
-    hold_force_scale: float = 0.05,
-    relax_iterations: int = 2000,
-    hook: StepHook | None = None,
-    problem: Callable[[RodSystem], Any] = ImmediateSystem,
-    start_state: State | None = None,
-    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
-):
-    """:func:`tie` as a generator of the solvers' questions (:mod:`tightknot.solvers.newton`):
-    every phase's system is handed to the solvers as ``problem(system)`` (default: answered
-    at once; a batch of rods answers many rods' questions together,
-    :mod:`tightknot.loading.batch`), starting from ``start_state`` (default: the scene's), with the
-    knot type computed by ``knot_type``. Returns the :class:`TieResult`."""
     if scene.contact is None:
         raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
                          "the rod passes through itself); use 'compliant', 'smoothed' or 'rigid'")
@@ -168,6 +161,17 @@ def tie_gen(
         raise ValueError(f"pull_force must be finite and > 0 N, got {pull_force!r}")
     if end_distance is not None and not (math.isfinite(end_distance) and end_distance > 0):
         raise ValueError(f"end_distance must be finite and > 0 m, got {end_distance!r}")
+    return Program(_tie(scene, pull_force, end_distance, tighten_steps, pull_steps,
+                        residual_tol, hold_force_scale, relax_iterations, hook, attach,
+                        start_state, knot_type), "tie")
+
+
+def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
+         tighten_steps: int, pull_steps: int, residual_tol: float, hold_force_scale: float,
+         relax_iterations: int, hook: StepHook | None,
+         attach: Callable[[RodSystem], None] | None, start_state: State | None,
+         knot_type: Callable[[KnotScene, np.ndarray], str]) -> Coroutine[TieResult]:
+    """The coroutine of :func:`tie` (its arguments checked)."""
     start = time.perf_counter()
     types: list[str] = []
     phases: dict[str, StaticResult] = {}
@@ -193,9 +197,8 @@ def tie_gen(
         bcs.force(0, last, lambda t: hold * axis)
     system = RodSystem(model, scene.state if start_state is None else start_state, bcs)
     system.add_term(scene.contact)
-    p = problem(system)
-    p.set_load(0.0)
-    relax = yield from newton_gen(p, system.free_vector(), NewtonOptions(
+    p = _attached(system, attach)
+    relax = yield from newton(p, system.free_vector(), NewtonOptions(
         residual_tol=residual_tol, max_iterations=relax_iterations))
     iters += relax.iterations
     if not relax.converged:
@@ -218,21 +221,18 @@ def tie_gen(
     bcs.rest_length_scale((1.0, shrink))
     system = RodSystem(model, system.state, bcs)
     system.add_term(scene.contact)
-    p = problem(system)
-    p.set_load(0.0)
+    p = _attached(system, attach)
 
     def similar(sys_: RodSystem, t0: float, t1: float) -> None:
         # Self-similar predictor: the previous equilibrium scaled about the pinned first
         # vertex (the origin) by the change of rest length keeps every strain; prescribed
-        # ends and the gauge's zero coordinates are unchanged by it. (``sys_``: the
-        # system, or a batch's rod: what has ``state`` and ``set_load``.)
+        # ends and the gauge's zero coordinates are unchanged by it.
         c = (1.0 + (shrink - 1.0) * t1) / (1.0 + (shrink - 1.0) * t0)
         sys_.state.x = sys_.state.x * c
         sys_.set_load(t1)
 
-    res = yield from continuation_gen(p, _opts(tighten_steps, residual_tol),
-                                      _checker(scene, "tighten", types, hook, knot_type),
-                                      similar)
+    res = yield from continuation(p, _opts(tighten_steps, residual_tol),
+                                  _checker(scene, "tighten", types, hook, knot_type), similar)
     phases["tighten"] = res
     iters += res.newton_iterations
     if not res.converged:
@@ -268,10 +268,9 @@ def tie_gen(
         final_force = math.nan
     system = RodSystem(model, state, bcs)
     system.add_term(scene.contact)
-    p = problem(system)
-    p.set_load(0.0)
-    res = yield from continuation_gen(p, _opts(pull_steps, residual_tol),
-                                      _checker(scene, "pull", types, hook, knot_type))
+    p = _attached(system, attach)
+    res = yield from continuation(p, _opts(pull_steps, residual_tol),
+                                  _checker(scene, "pull", types, hook, knot_type))
     phases["pull"] = res
     iters += res.newton_iterations
     if end_distance is not None:

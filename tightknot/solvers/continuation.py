@@ -18,11 +18,11 @@ import numbers
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
 
 from tightknot.rods.state import State
-from tightknot.solvers.dynamic import ImmediateSystem, proximal_gen
-from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton_gen, run_now
+from tightknot.solvers.dynamic import proximal
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton
+from tightknot.solvers.program import Coroutine, Evaluate, program
 from tightknot.solvers.system import RodSystem
 
 
@@ -37,7 +37,7 @@ class ContinuationOptions:
         grow_below: a step that converged in fewer Newton iterations than this doubles the next.
         newton: options of each Newton solve.
         proximal_dt: when set, a load step whose static solve fails is first retried by
-            proximal steps (:func:`tightknot.solvers.dynamic.proximal_relax`) starting with
+            proximal steps (:func:`tightknot.solvers.dynamic.proximal`) starting with
             this time step [s], before the step is halved: the way through a limit point.
         proximal_steps: their budget.
         max_newton_iterations: total Newton iterations of the whole path, failed attempts
@@ -113,32 +113,19 @@ StepCallback = Callable[[RodSystem, StepRecord], str | None]
 Predictor = Callable[[RodSystem, float, float], None]
 
 
-def solve_static(
-    system: RodSystem,
-    options: ContinuationOptions | None = None,
-    callback: StepCallback | None = None,
-    t_start: float = 0.0,
-    predictor: Predictor | None = None,
-) -> StaticResult:
-    """Follow the load path from ``t_start`` to 1.
+@program
+def continuation(p: RodSystem, options: ContinuationOptions | None = None,
+                 callback: StepCallback | None = None, predictor: Predictor | None = None,
+                 t_start: float = 0.0) -> Coroutine:
+    """Follow the load path of system ``p`` from ``t_start`` to 1, as a program
+    (:mod:`tightknot.solvers.program`); ``.run()`` returns the :class:`StaticResult`.
 
     ``callback(system, record)`` runs after each converged step; returning a string stops
     the run as failed with that reason (e.g. a topology check that found the knot changed).
     ``predictor(system, t, t_next)`` may move the state before each step's Newton solve.
     """
-    return run_now(continuation_gen(ImmediateSystem(system), options, callback, predictor,
-                                    t_start))
-
-
-def continuation_gen(p: Any, options: ContinuationOptions | None = None,
-                     callback: StepCallback | None = None,
-                     predictor: Callable[[Any, float, float], None] | None = None,
-                     t_start: float = 0.0):
-    """:func:`solve_static` as a generator over a problem ``p`` of the generator solvers
-    (:class:`tightknot.solvers.dynamic.ImmediateSystem`, or one rod of a batch): the
-    callback gets ``p.system``, the predictor ``p.handle``; returns the StaticResult."""
     opt = options or ContinuationOptions()
-    system = p.system
+    system = p
     start = time.perf_counter()
     t = float(t_start)
     dt = min(opt.max_step, (1.0 - t) / opt.steps) if t < 1.0 else 0.0
@@ -146,7 +133,7 @@ def continuation_gen(p: Any, options: ContinuationOptions | None = None,
     total_iters = 0
     if t >= 1.0 or dt == 0.0:
         p.set_load(1.0)
-        res = yield from newton_gen(p, system.free_vector(), opt.newton)
+        res = yield from newton(p, system.free_vector(), opt.newton)
         rec = StepRecord(1.0, res)
         total_iters += res.iterations
         if res.converged:
@@ -161,16 +148,16 @@ def continuation_gen(p: Any, options: ContinuationOptions | None = None,
         saved = system.state.copy()
         p.set_load(t_next)
         if predictor is not None:
-            predictor(p.handle, t, t_next)
-        res = yield from newton_gen(p, system.free_vector(), opt.newton)
+            predictor(p, t, t_next)
+        res = yield from newton(p, system.free_vector(), opt.newton)
         total_iters += res.iterations
         if not res.converged and opt.proximal_dt is not None:
             # The static path may have a limit point here: descend through it by proximal
             # (fully damped implicit) steps from the last iterate at this load.
-            prox = yield from proximal_gen(p, opt.proximal_dt, opt.proximal_steps, opt.newton)
+            prox = yield from proximal(p, opt.proximal_dt, opt.proximal_steps, opt.newton)
             total_iters += prox.newton_iterations
             if prox.converged:
-                _, g, _ = yield from p.evaluate(system.free_vector(), True, False)
+                _, g, _ = yield Evaluate(p, system.free_vector(), True, False)
                 res = NewtonResult(True, res.iterations + prox.newton_iterations,
                                    system.residual_norm(g), 0.0, p.last_split.total,
                                    "converged_by_proximal_steps", res.history)

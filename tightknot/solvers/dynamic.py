@@ -12,19 +12,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
-from tightknot.solvers.newton import (
-    Immediate,
-    NewtonOptions,
-    NewtonResult,
-    newton_gen,
-    newton_solve,
-    run_now,
-)
-from tightknot.solvers.system import EnergySplit, Inertia, RodSystem
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton
+from tightknot.solvers.program import Coroutine, program
+from tightknot.solvers.system import Inertia, RodSystem
 
 
 @dataclass
@@ -70,7 +63,7 @@ def implicit_euler_step(
     system.inertia = Inertia(dt=dt, q_hat=q_n + dt * vel, mass=system.dof_mass)
     opts = inertia_tolerance(system, dt, options or NewtonOptions())
     try:
-        res = newton_solve(system, system.free_vector(), opts)
+        res = newton(system, system.free_vector(), opts).run()
     finally:
         system.inertia = None
     if not res.converged:
@@ -119,37 +112,9 @@ class ProximalResult:
     reason: str
 
 
-class ImmediateSystem(Immediate):
-    """A :class:`RodSystem` as the generator solvers see it (:class:`Immediate`), with what
-    the proximal steps and the load continuation ask of it besides the Newton loop."""
-
-    @property
-    def system(self) -> RodSystem:
-        return self.problem
-
-    @property
-    def handle(self) -> RodSystem:
-        """What a continuation's predictor is given: the system."""
-        return self.system
-
-    @property
-    def last_split(self) -> EnergySplit:
-        return self.system.last_split
-
-    def set_load(self, t: float) -> None:
-        self.system.set_load(t)
-
-    def set_inertia(self, inertia: Inertia | None) -> None:
-        self.system.inertia = inertia
-
-
-def proximal_relax(
-    system: RodSystem,
-    dt: float = 1e-3,
-    max_steps: int = 200,
-    options: NewtonOptions | None = None,
-    grow_below: int = 8,
-) -> ProximalResult:
+@program
+def proximal(p: RodSystem, dt: float = 1e-3, max_steps: int = 200,
+             options: NewtonOptions | None = None, grow_below: int = 8) -> Coroutine:
     """Descend to an equilibrium through an instability by proximal steps.
 
     Each step minimises ``Pi(q) + sum m/(2 dt^2) |q - q_n|^2`` (implicit Euler with the
@@ -157,28 +122,23 @@ def proximal_relax(
     sec. 4.1), which always lowers the potential and is well posed where the static Hessian
     is not; dt grows after easy steps and shrinks after failed ones. It stops when a static
     Newton solve from the current state converges. The state's velocities stay zero.
+    A program (:mod:`tightknot.solvers.program`); ``.run()`` returns the
+    :class:`ProximalResult`.
     """
-    return run_now(proximal_gen(ImmediateSystem(system), dt, max_steps, options, grow_below))
-
-
-def proximal_gen(p: Any, dt: float = 1e-3, max_steps: int = 200,
-                 options: NewtonOptions | None = None, grow_below: int = 8):
-    """:func:`proximal_relax` as a generator over a problem ``p`` of the generator solvers
-    (:class:`ImmediateSystem`, or one rod of a batch); returns the ProximalResult."""
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be finite and > 0 s, got {dt!r}")
-    s = p.system
+    s = p
     if not (s.model.vertex_mass > 0).all():
         raise ValueError("proximal relaxation needs density > 0 for every rod")
     opts = options or NewtonOptions()
     iters = 0
     for k in range(1, max_steps + 1):
         saved = s.state.copy()
-        p.set_inertia(Inertia(dt=dt, q_hat=s.full_dofs(), mass=s.dof_mass))
+        p.inertia = Inertia(dt=dt, q_hat=s.full_dofs(), mass=s.dof_mass)
         try:
-            res = yield from newton_gen(p, s.free_vector(), opts)
+            res = yield from newton(p, s.free_vector(), opts)
         finally:
-            p.set_inertia(None)
+            p.inertia = None
         iters += res.iterations
         if not res.converged:
             s.state = saved
@@ -186,7 +146,7 @@ def proximal_gen(p: Any, dt: float = 1e-3, max_steps: int = 200,
             continue
         if res.iterations < grow_below:
             dt *= 2.0
-        static = yield from newton_gen(
+        static = yield from newton(
             p, s.free_vector(), NewtonOptions(residual_tol=opts.residual_tol, max_iterations=15))
         iters += static.iterations
         if static.converged:

@@ -53,3 +53,30 @@ class Factorization:
 def factorize(a: sp.spmatrix) -> Factorization:
     """Factorize ``a``; raises RuntimeError when it is exactly singular."""
     return Factorization(a)
+
+
+class SparseDirect:
+    """The Newton loop's linear algebra for a Hessian held as a scipy CSC matrix: shifted
+    systems ``(H + mu D) d = -g`` solved by :func:`factorize` (SuperLU)."""
+
+    @staticmethod
+    def matrix(h: sp.csc_matrix) -> sp.csc_matrix:
+        """The Hessian as a sparse matrix (for products)."""
+        return h
+
+    @staticmethod
+    def diagonal(h: sp.csc_matrix) -> np.ndarray:
+        """The Hessian's diagonal."""
+        return h.diagonal()
+
+    @staticmethod
+    def shifted_direction(h: sp.csc_matrix, g: np.ndarray, mu: float,
+                          diag: np.ndarray) -> np.ndarray | None:
+        """Solve (H + mu D) d = -g with D = diag(``diag``); None when singular or not
+        finite."""
+        a = h if mu == 0.0 else (h + sp.diags(mu * diag, format="csc"))
+        try:
+            d = factorize(a).solve(-g)
+        except RuntimeError:  # exactly singular
+            return None
+        return d if np.isfinite(d).all() else None

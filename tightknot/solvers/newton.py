@@ -21,61 +21,15 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Generator
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
-from tightknot.solvers.linear import factorize
+from tightknot.solvers.program import Coroutine, Evaluate, StepBound, accept, program
 
-
-class NewtonProblem(Protocol):
-    """What the Newton loop needs of a problem (see RodSystem)."""
-
-    def evaluate(
-        self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True
-    ) -> tuple[float, np.ndarray | None, sp.csc_matrix | None]: ...
-
-    def accept(self, u: np.ndarray) -> None: ...
-
-    def max_step(self, u: np.ndarray, du: np.ndarray) -> float: ...
-
-    def residual_norm(self, g: np.ndarray) -> float: ...
-
-    def step_norm(self, du: np.ndarray) -> float: ...
-
-    def energy_roundoff(self) -> float: ...
-
-
-class GeneratorProblem(Protocol):
-    """What the generator solvers (:func:`newton_gen`, and ``proximal_gen``,
-    ``continuation_gen``) need of a problem. ``evaluate``, ``max_step`` and ``accept`` are
-    generators (their answer may come from outside: a batch answers many rods together);
-    the rest is answered at once. ``proximal_gen`` and ``continuation_gen`` also use
-    ``system`` (the RodSystem), ``handle`` (what a predictor is given), ``last_split``,
-    ``set_load(t)`` and ``set_inertia(inertia)``."""
-
-    def evaluate(self, u: np.ndarray, want_grad: bool = True,
-                 want_hess: bool = True) -> Generator: ...
-
-    def max_step(self, u: np.ndarray, du: np.ndarray) -> Generator: ...
-
-    def accept(self, u: np.ndarray) -> Generator: ...
-
-    def residual_norm(self, g: np.ndarray) -> float: ...
-
-    def step_norm(self, du: np.ndarray) -> float: ...
-
-    def energy_roundoff(self) -> float: ...
-
-    def matrix(self, h: Any) -> sp.spmatrix: ...
-
-    def diagonal(self, h: Any) -> np.ndarray: ...
-
-    def shifted_direction(self, h: Any, g: np.ndarray, mu: float,
-                          diag: np.ndarray) -> np.ndarray | None: ...
+if TYPE_CHECKING:
+    from tightknot.solvers.system import RodSystem
 
 
 @dataclass
@@ -153,82 +107,15 @@ class NewtonResult:
     history: list[float] = field(default_factory=list)
 
 
-def newton_solve(
-    problem: NewtonProblem, u0: np.ndarray, options: NewtonOptions | None = None
-) -> NewtonResult:
-    """Minimise the problem's potential from ``u0``; accepted iterates go to the problem."""
-    return run_now(newton_gen(Immediate(problem), u0, options))
-
-
-class Immediate:
-    """A :class:`NewtonProblem` as a :class:`GeneratorProblem`: each question
-    (evaluation, step bound, acceptance) is answered at once, and the Newton systems are
-    solved by the sparse direct solver. The batch of rods (:mod:`tightknot.solvers.lockstep`)
-    answers the same questions for many rods together instead."""
-
-    def __init__(self, problem: NewtonProblem) -> None:
-        self.problem = problem
-
-    def evaluate(self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True):
-        """Generator returning ``problem.evaluate(u, ...)``."""
-        return self.problem.evaluate(u, want_grad, want_hess)
-        yield  # unreachable: makes this a generator whose answer is immediate
-
-    def max_step(self, u: np.ndarray, du: np.ndarray):
-        """Generator returning ``problem.max_step(u, du)``."""
-        return self.problem.max_step(u, du)
-        yield  # unreachable (as above)
-
-    def accept(self, u: np.ndarray):
-        """Generator making ``u`` the problem's state."""
-        self.problem.accept(u)
-        return
-        yield  # unreachable (as above)
-
-    def residual_norm(self, g: np.ndarray) -> float:
-        return self.problem.residual_norm(g)
-
-    def step_norm(self, du: np.ndarray) -> float:
-        return self.problem.step_norm(du)
-
-    def energy_roundoff(self) -> float:
-        return self.problem.energy_roundoff()
-
-    @staticmethod
-    def matrix(h: sp.csc_matrix) -> sp.csc_matrix:
-        """The Hessian as a sparse matrix (for products)."""
-        return h
-
-    @staticmethod
-    def diagonal(h: sp.csc_matrix) -> np.ndarray:
-        return h.diagonal()
-
-    @staticmethod
-    def shifted_direction(h: sp.csc_matrix, g: np.ndarray, mu: float,
-                          diag: np.ndarray) -> np.ndarray | None:
-        """Solve (H + mu D) d = -g; None when singular or not finite."""
-        return _shifted_direction(h, g, mu, diag)
-
-
-def run_now(gen: Generator) -> Any:
-    """Run a solver generator whose questions are all answered at once (it never yields);
-    its return value."""
-    try:
-        question = next(gen)
-    except StopIteration as done:
-        return done.value
-    raise RuntimeError(f"a solver run directly asked a question it cannot answer: {question!r}")
-
-
-def newton_gen(p: GeneratorProblem, u0: np.ndarray, options: NewtonOptions | None = None):
-    """The damped Newton loop (module docstring) as a generator: every evaluation, step
-    bound and acceptance is a sub-generator of the problem ``p`` (``yield from``), so one
-    loop serves a problem answered at once (:class:`Immediate`, :func:`newton_solve`) and
-    rods whose questions are answered together (:mod:`tightknot.solvers.lockstep`).
-    Returns the :class:`NewtonResult`."""
+@program
+def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -> Coroutine:
+    """The damped Newton loop (module docstring) minimising the potential of ``p`` from
+    free dofs ``u0``, as a program (:mod:`tightknot.solvers.program`): accepted iterates
+    become the system's state. ``newton(p, u0).run()`` returns the :class:`NewtonResult`.
+    The Newton systems are solved by the system's linear solver (``p.linear``)."""
     opt = options or NewtonOptions()
     u = np.array(u0, dtype=np.float64)
-    energy, g, hp = yield from p.evaluate(u, True, True)
+    energy, g, hp = yield Evaluate(p, u, True, True)
     if not (math.isfinite(energy) and np.isfinite(g).all()):
         return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
     res = p.residual_norm(g)
@@ -238,33 +125,33 @@ def newton_gen(p: GeneratorProblem, u0: np.ndarray, options: NewtonOptions | Non
     mu = 0.0
     step = math.inf
     if res <= opt.residual_tol:
-        yield from p.accept(u)
+        yield from accept(p, u)
         return NewtonResult(True, 0, res, 0.0, energy, "converged", history)
     # Progress record of the stall test: best residual and energy after each iteration.
     best = [res]
     energies = [energy]
     for it in range(1, opt.max_iterations + 1):
         accepted = False
-        h = p.matrix(hp)
-        diag = np.abs(p.diagonal(hp))
+        h = p.linear.matrix(hp)
+        diag = np.abs(p.linear.diagonal(hp))
         diag = np.maximum(diag, 1e-12 * (diag.max() if diag.size else 1.0))
         while not accepted:
-            d = p.shifted_direction(hp, g, mu, diag)
+            d = p.linear.shifted_direction(hp, g, mu, diag)
             # H d is kept for the model decrease after the line search.
             hd = None if d is None else h @ d
             if d is None or not _acceptable(d, g, hd, mu, diag):
                 mu = opt.shift_initial if mu == 0.0 else mu * 10.0
                 if mu > opt.shift_max:
-                    yield from p.accept(u)
+                    yield from accept(p, u)
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
                                         history)
                 continue
-            alpha = min(1.0, (yield from p.max_step(u, d)))
+            alpha = min(1.0, (yield StepBound(p, u, d)))
             slope = float(g @ d)
             roundoff = p.energy_roundoff()
             for _ in range(opt.max_backtracks):
                 trial = u + alpha * d
-                e_trial, _, _ = yield from p.evaluate(trial, False, False)
+                e_trial, _, _ = yield Evaluate(p, trial, False, False)
                 if not math.isfinite(e_trial):
                     alpha *= 0.5
                     continue
@@ -281,16 +168,16 @@ def newton_gen(p: GeneratorProblem, u0: np.ndarray, options: NewtonOptions | Non
             if not accepted:
                 mu = opt.shift_initial if mu == 0.0 else mu * 10.0
                 if mu > opt.shift_max:
-                    yield from p.accept(u)
+                    yield from accept(p, u)
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
                                         history)
         du = alpha * d
         predicted = -(alpha * slope + 0.5 * alpha * alpha * float(d @ hd))
         u = u + du
         step = p.step_norm(du)
-        yield from p.accept(u)
+        yield from accept(p, u)
         e_old = energy
-        energy, g, hp = yield from p.evaluate(u, True, True)
+        energy, g, hp = yield Evaluate(p, u, True, True)
         if not (math.isfinite(energy) and np.isfinite(g).all()):
             return NewtonResult(False, it, math.inf, step, energy, "non_finite", history)
         res = p.residual_norm(g)
@@ -328,17 +215,6 @@ def _stalled(best: list[float], energies: list[float], opt: NewtonOptions,
     if best[-1] < opt.stall_factor * best[-1 - w]:
         return False
     return energies[-1 - w] - energies[-1] <= opt.stall_roundoffs * roundoff
-
-
-def _shifted_direction(
-    h: sp.csc_matrix, g: np.ndarray, mu: float, diag: np.ndarray
-) -> np.ndarray | None:
-    a = h if mu == 0.0 else (h + sp.diags(mu * diag, format="csc"))
-    try:
-        d = factorize(a).solve(-g)
-    except RuntimeError:  # exactly singular
-        return None
-    return d if np.isfinite(d).all() else None
 
 
 def _acceptable(d: np.ndarray, g: np.ndarray, hd: np.ndarray, mu: float,

@@ -13,6 +13,7 @@ Reference frames are carried from the last accepted state by time-parallel trans
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,6 +25,7 @@ from tightknot.rods.model import Model
 from tightknot.rods.staging import Output
 from tightknot.rods.state import State
 from tightknot.rods.term import EnergyTerm
+from tightknot.solvers.linear import SparseDirect
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
 
@@ -61,7 +63,14 @@ class EnergySplit:
 
 
 class RodSystem:
-    """Energy, gradient and Hessian of a model under boundary conditions at load parameter t.
+    """Energy, gradient and Hessian of a model under boundary conditions at load parameter t:
+    the one problem the solvers' programs (:mod:`tightknot.solvers.program`) ask about.
+
+    A system is evaluated by itself (:meth:`evaluate`), or, when a batch has attached it
+    (``batch``: :class:`tightknot.solvers.lockstep.BatchRod`), together with the other rods
+    of its batch, whose joint answer :meth:`evaluated` completes as :meth:`evaluate` would.
+    Its Newton systems are solved by ``linear`` (sparse direct by default; a batch rod's
+    banded solver).
 
     Args:
         model: the rods.
@@ -109,6 +118,10 @@ class RodSystem:
         self._cpattern: ContactPattern | None = None
         self._cdata = Output(wp.float64, model.device)
         self._trial: tuple[np.ndarray, ...] | None = None
+        #: The linear algebra of the Newton loop (SuperLU; a batch rod's banded solver).
+        self.linear: Any = SparseDirect()
+        #: The batch that answers this system's evaluations, None when it answers them.
+        self.batch: Any = None
         self.set_load(0.0)
 
     def add_term(self, term: EnergyTerm) -> None:
@@ -138,6 +151,8 @@ class RodSystem:
         self._trial = None
         # A new load step: contact blocks that stopped interacting leave the pattern.
         self.compact_pattern()
+        if self.batch is not None:
+            self.batch.loaded(self)
 
     # -- dof vectors -----------------------------------------------------------------
     def full_dofs(self) -> np.ndarray:
@@ -164,6 +179,9 @@ class RodSystem:
         self, u: np.ndarray, want_grad: bool = True, want_hess: bool = True
     ) -> tuple[float, np.ndarray | None, sp.csc_matrix | None]:
         """Total potential [J], its gradient on the free dofs, and the free-dof Hessian."""
+        if self.batch is not None:
+            raise RuntimeError("this system is a rod of a batch: its evaluations are answered "
+                               "by the batch (tightknot.solvers.lockstep.run_lockstep)")
         m, st = self.model, self.state
         x, theta = self._split(u)
         d1, tt, mref = self.forces.transport_frames(x, st.d1_ref, st.t_ref, st.m_ref)
@@ -211,14 +229,7 @@ class RodSystem:
                 grad[m.position_dofs] += g_k
             if want_hess and h_k is not None:
                 coo_parts.append(h_k)
-        if self.inertia is not None:
-            q = self.full_dofs()
-            q[self.pattern.free_dofs] = u
-            dq = q - self.inertia.q_hat
-            w = self.inertia.mass / self.inertia.dt**2
-            split.inertia = 0.5 * float(np.sum(w * dq * dq))
-            if grad is not None:
-                grad += w * dq
+        grad = self._with_inertia(u, split, grad)
         self.last_split = split
         g_free = grad[self.pattern.free_dofs] if grad is not None else None
         hmat = None
@@ -230,13 +241,53 @@ class RodSystem:
                 full = self._cdata.numpy(pattern.nnz)
                 full[pattern.elastic_slot] += data
                 data = full
-            if self.inertia is not None:
-                w = self.inertia.mass / self.inertia.dt**2
-                data[pattern.diag_slot] += w[self.pattern.free_dofs]
+            self._add_inertia_diagonal(data, pattern.diag_slot)
             hmat = pattern.matrix(data)
             if coo_parts:
                 hmat = hmat + self._coo_free(coo_parts)
         return split.total, g_free, hmat
+
+    def evaluated(self, u: np.ndarray, x: np.ndarray, theta: np.ndarray, answer: Any,
+                  want_grad: bool, want_hess: bool) -> tuple[float, np.ndarray | None, Any]:
+        """:meth:`evaluate`'s result at ``u`` (positions ``x``, twist ``theta``) from a
+        batch's answer (:class:`tightknot.solvers.batch_eval.EvalAnswer`: energy parts, the
+        gradient over all dofs, the Hessian and the carried frames of this rod): the
+        inertia term added, the free dofs taken. The Hessian stays the batch's
+        :class:`~tightknot.solvers.batch_eval.HessianData` (its banded solver's input)."""
+        self._trial = (u.copy(), x, theta, answer.d1, answer.t, answer.m_ref)
+        split = EnergySplit(stretch=answer.stretch, bend=answer.bend, twist=answer.twist)
+        split.extra["contact"] = answer.contact
+        grad = self._with_inertia(u, split, answer.grad)
+        self.last_split = split
+        g_free = grad[self.pattern.free_dofs] if (want_grad or want_hess) else None
+        h = None
+        if want_hess:
+            h = answer.hess
+            if self.inertia is not None:
+                data = h.data.copy()
+                self._add_inertia_diagonal(data, h.diag_slot)
+                h = type(h)(h.indptr, h.indices, h.diag_slot, data)
+        return split.total, g_free, h
+
+    def _with_inertia(self, u: np.ndarray, split: EnergySplit,
+                      grad: np.ndarray | None) -> np.ndarray | None:
+        """The inertia term of implicit dynamics (module docstring) at ``u``: its energy
+        into ``split``, and ``grad`` (all dofs) with its gradient added (a new array)."""
+        if self.inertia is None:
+            return grad
+        q = self.full_dofs()
+        q[self.pattern.free_dofs] = u
+        dq = q - self.inertia.q_hat
+        w = self.inertia.mass / self.inertia.dt**2
+        split.inertia = 0.5 * float(np.sum(w * dq * dq))
+        return None if grad is None else grad + w * dq
+
+    def _add_inertia_diagonal(self, data: np.ndarray, diag_slot: np.ndarray) -> None:
+        """Add the inertia term's Hessian m/dt^2 to the diagonal entries ``diag_slot`` of the
+        free-dof Hessian data ``data`` (in place)."""
+        if self.inertia is not None:
+            w = self.inertia.mass / self.inertia.dt**2
+            data[diag_slot] += w[self.pattern.free_dofs]
 
     def compact_pattern(self) -> None:
         """Drop contact blocks that no longer interact (call between load steps: a pattern
@@ -264,9 +315,13 @@ class RodSystem:
         dx = self.positions(u + du) - x0
         return min(term.max_step(x0, dx) for term in self.extra_terms)
 
+    def has_trial(self, u: np.ndarray) -> bool:
+        """The last evaluation was at ``u`` (its frames are at hand for :meth:`accept`)."""
+        return self._trial is not None and np.array_equal(self._trial[0], u)
+
     def accept(self, u: np.ndarray) -> None:
         """Make ``u`` the state (positions, twist, transported frames)."""
-        if self._trial is None or not np.array_equal(self._trial[0], u):
+        if not self.has_trial(u):
             self.evaluate(u, want_grad=False, want_hess=False)
         _, x, theta, d1, tt, mref = self._trial
         st = self.state

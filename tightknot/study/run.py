@@ -204,9 +204,9 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
 
     target = tie_options.pop("target_lambda", None)
     if target is not None:
-        res = tie_to_lambda(scene, target, hook=hook, **tie_options)
+        res = tie_to_lambda(scene, target, hook=hook, **tie_options).run()
     else:
-        res = tie(scene, hook=hook, **tie_options)
+        res = tie(scene, hook=hook, **tie_options).run()
     x = res.system.state.x
     if log is not None and not np.array_equal(logged.get("x"), x):
         log.set_step(counter[0])

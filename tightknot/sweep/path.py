@@ -39,7 +39,7 @@ from tightknot.knots.scenes import (
     vertex_radii,
 )
 from tightknot.loading.tie import TieResult, end_reaction, knot_type_of, tie
-from tightknot.solvers.newton import NewtonOptions, newton_solve
+from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.system import RodSystem
 
 #: Level kinds: a pulling force [N] or a target knot length Lambda_OC.
@@ -144,7 +144,7 @@ class _Pull:
         """Equilibrium under force ``f`` [N] from the current state; "" on success, else
         the reason (the state is then put back)."""
         from tightknot.loading.recentre import recentre_system
-        from tightknot.solvers.dynamic import proximal_relax
+        from tightknot.solvers.dynamic import proximal
 
         _, moved = recentre_system(self.scene, self.system)
         if moved is not None and self._previous is not None:
@@ -157,13 +157,13 @@ class _Pull:
         self._applied = f
         self.system.set_load(1.0)
         self.solves += 1
-        r = newton_solve(self.system, self.system.free_vector(), self.options)
+        r = newton(self.system, self.system.free_vector(), self.options).run()
         self.iterations += r.iterations
         why = ""
         if not r.converged:
             # A limit point (a loop flips, the contact set jumps): proximal steps descend to
             # the next equilibrium where static Newton has no nearby solution (as tie_to_lambda).
-            prox = proximal_relax(self.system, 1e-3, self.proximal_steps, self.options)
+            prox = proximal(self.system, 1e-3, self.proximal_steps, self.options).run()
             self.iterations += prox.newton_iterations
             if not prox.converged:
                 why = f"Newton {r.reason} at force {f:.4g} N"
@@ -390,7 +390,7 @@ def tightness_path(
         raise ValueError(f"lambda_tolerance must be finite and > 0, got {lambda_tolerance!r}")
     levels = sorted(raw, reverse=(kind == LAMBDA))
     start = time.perf_counter()
-    tied = tie(scene, tighten_steps=tighten_steps, residual_tol=residual_tol)
+    tied = tie(scene, tighten_steps=tighten_steps, residual_tol=residual_tol).run()
     t_tie = time.perf_counter() - start
     if not tied.converged:
         return PathResult(False, f"tie: {tied.failure}", tied, [], t_tie,

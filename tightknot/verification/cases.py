@@ -20,9 +20,9 @@ from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment, section_area
 from tightknot.rods.model import Model
 from tightknot.rods.state import State
-from tightknot.solvers.continuation import ContinuationOptions, solve_static
+from tightknot.solvers.continuation import ContinuationOptions, continuation
 from tightknot.solvers.dynamic import implicit_euler_step, kinetic_energy
-from tightknot.solvers.newton import newton_solve
+from tightknot.solvers.newton import newton
 from tightknot.solvers.system import RodSystem
 from tightknot.verification.elastica import cantilever_tip
 
@@ -87,7 +87,7 @@ def cantilever_small_deflection(device: str = "cpu") -> list[VerifyRow]:
         model = _clamped_straight_rod(n, device=device)
         sys_ = RodSystem(model, State.initial(model),
                          BoundaryConditions(model).clamp(0, "start").force(0, -1, [0, -load, 0]))
-        res = solve_static(sys_)
+        res = continuation(sys_).run()
         got = -sys_.state.x[-1, 1]
         err = abs(got - ref) / ref
         order = math.log2(errs[-1] / err) if errs else None
@@ -107,7 +107,7 @@ def cantilever_large_deflection(device: str = "cpu") -> list[VerifyRow]:
     model = _clamped_straight_rod(100, device=device)
     sys_ = RodSystem(model, State.initial(model),
                      BoundaryConditions(model).clamp(0, "start").force(0, -1, [0, -load, 0]))
-    res = solve_static(sys_, ContinuationOptions(steps=6))
+    res = continuation(sys_, ContinuationOptions(steps=6)).run()
     tip = sys_.state.x[-1]
     # 0.5 % is the target; the expected error is O(h^2) ~ 1e-4 plus the rod's
     # extensibility F/(EA) ~ 2e-5, both far below it.
@@ -140,7 +140,7 @@ def euler_buckling(device: str = "cpu") -> list[VerifyRow]:
         bcs = BoundaryConditions(model).clamp(0, "start").force(0, -1, [-p, 0.0, 0.0])
         sys_ = RodSystem(model, state0.copy(), bcs)
         sys_.set_load(1.0)
-        res = newton_solve(sys_, sys_.free_vector())
+        res = newton(sys_, sys_.free_vector()).run()
         if not res.converged:
             raise RuntimeError("straight column did not converge")
         return _min_eig(sys_)
@@ -161,7 +161,7 @@ def ring_at_rest(device: str = "cpu") -> list[VerifyRow]:
               diameter=DIAMETER, material=Material(MODULUS, 0.5, 1000.0), closed=True)
     model = b.finalize(device)
     sys_ = RodSystem(model, State.initial(model))
-    res = newton_solve(sys_, sys_.free_vector())
+    res = newton(sys_, sys_.free_vector()).run()
     x = sys_.state.x
     e0 = x - np.roll(x, 1, axis=0)
     e1 = np.roll(x, -1, axis=0) - x
@@ -221,7 +221,7 @@ def michell_instability(device: str = "cpu") -> list[VerifyRow]:
                       closed=True, link_offset=link)
             model = b.finalize(device)
             sys_ = RodSystem(model, State.initial(model))
-            res = newton_solve(sys_, sys_.free_vector())
+            res = newton(sys_, sys_.free_vector()).run()
             if not res.converged:
                 raise RuntimeError("twisted ring did not converge")
             _, _, h = sys_.evaluate(sys_.free_vector(), True, True)
@@ -252,7 +252,7 @@ def neo_hookean_stretch(device: str = "cpu") -> list[VerifyRow]:
     model = _clamped_straight_rod(20, material=mat, device=device)
     sys_ = RodSystem(model, State.initial(model),
                      BoundaryConditions(model).clamp(0, "start").force(0, -1, [force, 0, 0]))
-    res = solve_static(sys_, ContinuationOptions(steps=4))
+    res = continuation(sys_, ContinuationOptions(steps=4)).run()
     e = np.diff(sys_.state.x, axis=0)
     lam = float(np.linalg.norm(e[1:], axis=1).mean() / model.edge_rest_length[1:].mean())
     tension = mat.neo_hookean_mu * section_area(DIAMETER) * (lam - lam**-2)
@@ -297,7 +297,7 @@ def implicit_euler(device: str = "cpu") -> list[VerifyRow]:
     bcs = BoundaryConditions(model).clamp(0, "start")
     static = RodSystem(model, State.initial(model), bcs, gravity=g)
     static.set_load(1.0)
-    rs = newton_solve(static, static.free_vector())
+    rs = newton(static, static.free_vector()).run()
     dyn = RodSystem(model, State.initial(model), BoundaryConditions(model).clamp(0, "start"),
                     gravity=g)
     dyn.set_load(1.0)
