@@ -24,6 +24,7 @@ class _Blocked:
     layer blocks steps that would pass through): no progress is possible."""
 
     linear = SparseDirect()
+    violation = None
 
     def __init__(self, n: int = 3) -> None:
         self.target = np.ones(n)

@@ -105,6 +105,7 @@ class ContactLayer(EnergyTerm):
 
     name = "contact"
     assembles_in_place = True
+    keeps_apart = True
 
     def __init__(
         self,

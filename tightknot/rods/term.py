@@ -28,6 +28,10 @@ class EnergyTerm(Protocol):
     name: str = "term"
     #: The term adds its Hessian into the system's CSC data (:meth:`evaluate_into`).
     assembles_in_place: bool = False
+    #: The term keeps pieces of rod from passing through each other (a contact layer):
+    #: the system then checks every accepted state independently
+    #: (:class:`tightknot.rods.proximity.ProximityCheck`).
+    keeps_apart: bool = False
 
     def evaluate(self, x: np.ndarray, rest: np.ndarray, want_grad: bool,
                  want_hess: bool) -> tuple[float, np.ndarray | None, Coo | None]:

@@ -141,7 +141,8 @@ def continuation(p: RodSystem, options: ContinuationOptions | None = None,
         return StaticResult(res.converged, 1.0, records, total_iters,
                             "" if res.converged else
                             f"Newton {res.reason} (residual {res.residual:.3g}) at load step 1 "
-                            "(t=1)", time.perf_counter() - start,
+                            f"(t=1){': ' + system.violation if system.violation else ''}",
+                            time.perf_counter() - start,
                             None if res.converged else system.state.copy())
     while t < 1.0 - 1e-14:
         t_next = min(1.0, t + dt)
@@ -151,7 +152,7 @@ def continuation(p: RodSystem, options: ContinuationOptions | None = None,
             predictor(p, t, t_next)
         res = yield from newton(p, system.free_vector(), opt.newton)
         total_iters += res.iterations
-        if not res.converged and opt.proximal_dt is not None:
+        if not res.converged and opt.proximal_dt is not None and res.reason != "passed_through":
             # The static path may have a limit point here: descend through it by proximal
             # (fully damped implicit) steps from the last iterate at this load.
             prox = yield from proximal(p, opt.proximal_dt, opt.proximal_steps, opt.newton)
@@ -164,6 +165,7 @@ def continuation(p: RodSystem, options: ContinuationOptions | None = None,
         where = f"load step {len(records) + 1} (from t={t:.6g} to t={t_next:.6g})"
         if not res.converged:
             failed = system.state.copy()
+            passed = f": {system.violation}" if res.reason == "passed_through" else ""
             system.state = saved
             p.set_load(t)
             dt *= 0.5
@@ -176,7 +178,8 @@ def continuation(p: RodSystem, options: ContinuationOptions | None = None,
             if why is not None:
                 return StaticResult(
                     False, t, records, total_iters,
-                    f"Newton {res.reason} (residual {res.residual:.3g}) at {where}; {why}",
+                    f"Newton {res.reason}{passed} (residual {res.residual:.3g}) at {where}; "
+                    f"{why}",
                     time.perf_counter() - start, failed)
             continue
         rec = StepRecord(t_next, res)

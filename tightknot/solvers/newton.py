@@ -94,7 +94,8 @@ class NewtonResult:
         step: last scaled step [-].
         energy: final total potential [J].
         reason: why the loop stopped ("converged", "max_iterations", "stagnated",
-            "stalled", "line_search_failed", "non_finite").
+            "stalled", "line_search_failed", "non_finite", "passed_through": an accepted
+            iterate failed the system's independent proximity check, ``p.violation``).
         history: scaled residual after each iteration.
     """
 
@@ -176,6 +177,9 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
         u = u + du
         step = p.step_norm(du)
         yield from accept(p, u)
+        if p.violation is not None:
+            # The independent check found two pieces of rod closer than its floor.
+            return NewtonResult(False, it, res, step, energy, "passed_through", history)
         e_old = energy
         energy, g, hp = yield Evaluate(p, u, True, True)
         if not (math.isfinite(energy) and np.isfinite(g).all()):

@@ -22,6 +22,7 @@ import warp as wp
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.elastic import ElasticForces
 from tightknot.rods.model import Model
+from tightknot.rods.proximity import ProximityCheck
 from tightknot.rods.staging import Output
 from tightknot.rods.state import State
 from tightknot.rods.term import EnergyTerm
@@ -122,6 +123,12 @@ class RodSystem:
         self.linear: Any = SparseDirect()
         #: The batch that answers this system's evaluations, None when it answers them.
         self.batch: Any = None
+        #: The independent check of every accepted state (on once a term keeps rods apart).
+        self.proximity: ProximityCheck | None = None
+        #: Accepted states since the last load step, and the first one that came closer
+        #: than the check's floor: why a solve must stop (None while none did).
+        self.accepted_count = 0
+        self.violation: str | None = None
         self.set_load(0.0)
 
     def add_term(self, term: EnergyTerm) -> None:
@@ -129,6 +136,8 @@ class RodSystem:
         (``term.check_state``: a start that already violates it is refused)."""
         term.check_state(self.state.x)
         self.extra_terms.append(term)
+        if term.keeps_apart and self.proximity is None:
+            self.proximity = ProximityCheck(self.model)
 
     # -- load path -------------------------------------------------------------------
     def set_load(self, t: float) -> None:
@@ -149,6 +158,8 @@ class RodSystem:
         st.x, st.d1_ref, st.t_ref, st.m_ref = x, d1, tt, mref
         self.bcs.prescribe_twist(self.t, st.theta, st.d1_ref, st.t_ref)
         self._trial = None
+        self.accepted_count = 0
+        self.violation = None
         # A new load step: contact blocks that stopped interacting leave the pattern.
         self.compact_pattern()
         if self.batch is not None:
@@ -328,6 +339,14 @@ class RodSystem:
         st.x, st.d1_ref, st.t_ref, st.m_ref = x.copy(), d1, tt, mref
         if self.model.twist:
             st.theta = theta.copy()
+        if self.proximity is not None:
+            self.accepted_count += 1
+            near = self.proximity.check(st.x, self.rest)
+            if near.violated and self.violation is None:
+                d0 = float(2.0 * self.model.edge_radius.max())
+                self.violation = (f"the rod passes through itself: at accepted iterate "
+                                  f"{self.accepted_count} of load t={self.t:.6g}, "
+                                  f"{near.describe(d0)}")
 
     def energy_roundoff(self) -> float:
         """An upper estimate of the round-off of the last total potential [J]."""
