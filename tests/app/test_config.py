@@ -105,5 +105,5 @@ def test_tie_options() -> None:
     assert pulled.tie_options()["end_distance"] == 0.1
     assert pulled.tie_options()["pull_force"] is None
     lam = config_from_dict({"knot": "open", "target_lambda": 12.0})
-    assert lam.tie_options() == {"target_lambda": 12.0, "residual_tol": 1e-6}
+    assert lam.tie_options() == {"target_lambda": 12.0, "tolerance": 0.1, "residual_tol": 1e-6}
     assert isinstance(lam, TieConfig) and lam.scene_name == "open_trefoil"

@@ -39,22 +39,25 @@ def test_grid_is_the_product_of_the_axes_without_duplicates() -> None:
 
 
 @pytest.mark.parametrize(("params", "words"), [
-    ({"knot": "loop"}, "knot must be one of"),
-    ({"knot": "closed", "nodes": 10}, "nodes must be a whole number >= 24"),
-    ({"knot": "closed", "nodes": 40.5}, "nodes must be a whole number"),
-    ({"knot": "closed", "l0_over_d0": 5}, "l0_over_d0 must be >= 10"),
-    ({"knot": "closed", "poisson": 0.7}, "poisson must be in (-1, 0.5]"),
-    ({"knot": "closed", "youngs_modulus": float("nan")}, "youngs_modulus must be a finite"),
-    ({"knot": "closed", "youngs_modulus": -1.0}, "youngs_modulus must be > 0 Pa"),
-    ({"knot": "closed", "contact": "sticky"}, "contact must be one of"),
+    ({"knot": "loop"}, "knot: 'loop' is not one of: closed, open"),
+    ({"knot": "closed", "nodes": 10}, "nodes: 10 is out of range; valid: [24, 200000]"),
+    ({"knot": "open", "nodes": 30, "pull_force": [1.0]},
+     "nodes: 30 is out of range for open knots; valid: [40,"),
+    ({"knot": "closed", "nodes": 40.5}, "nodes: expected an integer"),
+    ({"knot": "closed", "l0_over_d0": 5}, "l0_over_d0: 5.0 is out of range; valid: [10, 10000]"),
+    ({"knot": "closed", "poisson": 0.7}, "poisson: 0.7 is out of range; valid: (-1, 0.5]"),
+    ({"knot": "closed", "youngs_modulus": float("nan")}, "youngs_modulus: nan is out of range"),
+    ({"knot": "closed", "youngs_modulus": -1.0}, "valid: (0, 1e+12] Pa (Young's modulus E)"),
+    ({"knot": "closed", "contact": "sticky"}, "contact: 'sticky' is not one of: compliant"),
     ({"knot": "closed", "pull_force": [1.0]}, "unknown parameter(s) ['pull_force']"),
     ({"knot": "open"}, "exactly one level list"),
     ({"knot": "open", "pull_force": [1.0], "target_lambda": [14]}, "exactly one level list"),
     ({"knot": "open", "pull_force": []}, "non-empty list"),
-    ({"knot": "open", "pull_force": [1.0, -2.0]}, "pull_force[1] must be > 0 N"),
+    ({"knot": "open", "pull_force": [1.0, -2.0]}, "pull_force[1]: -2.0 is out of range; "
+                                                    "valid: (0, 1e+06] N"),
     ({"knot": "open", "target_lambda": [14, 14.0]}, "lists a level twice"),
     ({"knot": "open", "length": 0.05, "pull_force": [1.0]}, "length must be >= 10 D0"),
-    ({"knot": "open", "twist": "yes", "pull_force": [1.0]}, "twist must be true or false"),
+    ({"knot": "open", "twist": "yes", "pull_force": [1.0]}, "twist: expected true or false"),
 ])
 def test_bad_parameters_are_refused_with_their_name_and_range(params: dict,
                                                               words: str) -> None:
@@ -75,7 +78,7 @@ def test_knot_types_have_their_own_default_lengths() -> None:
     assert Case.of({"knot": "closed", "knot_type": "4_1"}).params["l0_over_d0"] == 22.1
     assert Case.of({"knot": "open", "knot_type": "4_1", "pull_force": [2]}).params["length"] \
         == 0.30
-    with pytest.raises(ValueError, match="knot_type must be one of"):
+    with pytest.raises(ValueError, match="knot_type: '5_1' is not one of"):
         Case.of({"knot": "closed", "knot_type": "5_1"})
 
 

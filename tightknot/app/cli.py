@@ -72,6 +72,7 @@ _TIE_EXAMPLES = """examples:
   tightknot tie open --length 0.185 --target-lambda 15.0 --out runs/loose
   tightknot tie open --length 0.125 --target-lambda 10.1 --out runs/tight
   tightknot tie open --length 0.185 --force 5 --json open.json
+  tightknot tie closed --knot-type 4_1 --out runs/eight  # the figure-eight knot
   tightknot tie --config runs/tight/config.json --out runs/tight-again   # rerun a run
   tightknot tie --config runs/tight/config.json --nodes 400              # ... with a change
 
@@ -86,31 +87,29 @@ run folder (--out DIR, default runs/<scene>-<UTC time>):
 Exit codes: 0 converged, 1 the physics failed (summary and .rrd are still written), 2 bad input.
 """
 
-# Tie flags that set a config key (flag dest = key); None = not given on the command line.
-_TIE_KEYS = ("l0_over_d0", "length", "force", "end_distance", "target_lambda", "nodes",
-             "diameter", "youngs_modulus", "poisson", "density", "tighten_steps", "pull_steps",
-             "residual_tol", "relax_iterations", "contact", "color_by", "device")
-_TIE_LOADS = ("force", "end_distance", "target_lambda")
-
-
 def tie_config(args: argparse.Namespace):
     """The run's :class:`tightknot.app.config.TieConfig`: ``--config FILE`` (if given), then the
     knot and every flag given on the command line on top (a load flag replaces the file's
-    load)."""
-    from tightknot.app.config import config_from_dict, load_config
+    load). Every config key but the knot is a flag of the same name (``--name-with-dashes``)."""
+    from tightknot.app.config import config_from_dict, config_keys, knot_specific, load_config
+    from tightknot.loading.options import LOADS
 
     data: dict = load_config(args.config).to_dict() if args.config is not None else {}
-    if args.knot is not None:
-        if data.get("knot") not in (None, args.knot):
-            # Another knot: the file's knot-specific values do not carry over.
-            data = {k: v for k, v in data.items()
-                    if k not in ("nodes", "length", "l0_over_d0") + _TIE_LOADS}
-        data["knot"] = args.knot
-    if "knot" not in data:
+    knot = args.knot if args.knot is not None else data.get("knot")
+    if knot is None:
         raise ValueError("give the knot (closed or open) or --config FILE")
-    flags = {k: getattr(args, k) for k in _TIE_KEYS if getattr(args, k) is not None}
-    if any(k in flags for k in _TIE_LOADS):
-        data = {k: v for k, v in data.items() if k not in _TIE_LOADS}
+    if "knot" in data:
+        old = (data["knot"], data["knot_type"])
+        new = (knot, args.knot_type or old[1])
+        if new != old:
+            # Another knot: the file's values for its own knot do not carry over.
+            drop = knot_specific(old, new)
+            data = {k: v for k, v in data.items() if k not in drop}
+    data["knot"] = knot
+    flags = {k: getattr(args, k) for k in config_keys()
+             if k != "knot" and getattr(args, k) is not None}
+    if any(k in flags for k in LOADS):
+        data = {k: v for k, v in data.items() if k not in LOADS}
     data.update(flags)
     return config_from_dict(data)
 
@@ -120,8 +119,7 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     from tightknot.app.run_folder import plan_outputs, write_centerline
     from tightknot.atomic import write_json_atomic
     from tightknot.knots.ideal import load_ideal_trefoil
-    from tightknot.knots.scenes import closed_trefoil, open_trefoil
-    from tightknot.rods.material import Material
+    from tightknot.study.params import build_scene
     from tightknot.study.run import draw_figures, run_knot
     from tightknot.viz.rerun_log import make_logger
     from tightknot.warp_setup import resolve_device
@@ -132,20 +130,13 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     # The device actually used goes into config.json (None would mean "cpu" here but
     # perhaps not in a later version): the file records what ran.
     cfg = dataclasses.replace(cfg, device=resolve_device(cfg.device))
-    device = cfg.device
-    material = Material(cfg.youngs_modulus, cfg.poisson, cfg.density)
-    if cfg.knot == "closed":
-        scene = closed_trefoil(cfg.l0_over_d0, cfg.diameter, cfg.nodes, material, device=device,
-                               contact=cfg.contact)
-    else:
-        scene = open_trefoil(cfg.length, cfg.diameter, cfg.nodes, material, device=device,
-                             contact=cfg.contact)
+    scene = build_scene(cfg.to_dict(), cfg.device)
     outs.create()
     # The parameters first: a run killed half-way can still be repeated.
     write_json_atomic(outs.config, cfg.to_dict())
     bar = Progress(scene.name, enabled=False if args.quiet else None)
     with make_logger(outs.rrd) as log:
-        if scene.closed:
+        if scene.closed and scene.knot_type == "3_1":
             ideal = load_ideal_trefoil(scene.diameter)
             # Beside the rod (6 D0 below), so that both stay visible.
             log.log_reference("ideal_trefoil",
@@ -303,54 +294,33 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_verify)
 
-    from tightknot.app.config import COLOR_ALIASES, COLOR_FIELDS, config_keys
+    from tightknot.app.config import TieConfig, config_keys
+    from tightknot.loading.options import flag, flag_kwargs, parameters
 
-    p = sub.add_parser("tie", help="tie and tighten the study's trefoils, measure them",
-                       description="Tie a closed trefoil (rest length L0 = l0/d0 D0) or an "
-                       "open trefoil (tightened, then pulled by a force, to an end-to-end "
+    p = sub.add_parser("tie", help="tie and tighten the study's knots, measure them",
+                       description="Tie a closed knot (rest length L0 = l0/d0 D0) or an "
+                       "open knot (tightened, then pulled by a force, to an end-to-end "
                        "distance or to a target Lambda_OC) in an elastomer rod, measure it as "
-                       "the study did, and write everything into one run folder.",
+                       "the study did, and write everything into one run folder. An open knot "
+                       "takes exactly one load: --force, --end-distance or --target-lambda. "
+                       "Each option but --config and the outputs is a config key of the same "
+                       "name.",
                        epilog=_TIE_EXAMPLES.format(keys=textwrap.fill(
                            "config keys: " + ", ".join(config_keys()) + ".", 90)),
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("knot", nargs="?", choices=["closed", "open"],
-                   help="closed or open trefoil (optional with --config)")
+    params = parameters(TieConfig)
+    p.add_argument("knot", nargs="?", choices=params["knot"].valid,
+                   help=f"{params['knot'].what} (optional with --config)")
     p.add_argument("--config", metavar="FILE",
                    help="parameters from a run folder's config.json (or TOML); flags override")
-    p.add_argument("--l0-over-d0", type=float, default=None, help="closed: L0/D0 (16.37)")
-    p.add_argument("--length", type=float, default=None, help="open: rest length L0 [m] (0.185)")
-    p.add_argument("--force", type=float, default=None, help="open: pulling force [N]")
-    p.add_argument("--end-distance", type=float, default=None,
-                   help="open: final end-to-end distance [m]")
-    p.add_argument("--target-lambda", type=float, default=None,
-                   help="open: pull until Lambda_OC reaches this (within 0.1)")
-    p.add_argument("--nodes", type=int, default=None, help="vertices (200 closed, 300 open)")
-    p.add_argument("--diameter", type=float, default=None, help="rest diameter D0 [m] (8.5e-3)")
-    p.add_argument("--youngs-modulus", type=float, default=None, help="E [Pa] (1.25e6)")
-    p.add_argument("--poisson", type=float, default=None, help="Poisson ratio in (-1, 0.5] (0.5)")
-    p.add_argument("--density", type=float, default=None, help="density [kg/m^3] (1160)")
-    p.add_argument("--tighten-steps", type=int, default=None,
-                   help="initial load steps of the tightening (40)")
-    p.add_argument("--pull-steps", type=int, default=None,
-                   help="initial load steps of the pull (10)")
-    p.add_argument("--residual-tol", type=float, default=None,
-                   help="Newton tolerance on the scaled residual (1e-6)")
-    p.add_argument("--relax-iterations", type=int, default=None,
-                   help="Newton budget of the start curve's relaxation (2000)")
-    p.add_argument("--contact", default=None, choices=["compliant", "smoothed", "rigid"],
-                   help="contact level: compliant (default), smoothed (sections thinned by "
-                   "the stretch averaged over +-1 D0: closer to the FEM at a crossing, 1.7 to "
-                   "2.6 times the time), rigid (a rigid tube)")
-    p.add_argument("--color-by", default=None, metavar="FIELD",
-                   choices=list(COLOR_FIELDS) + list(COLOR_ALIASES),
-                   help=f"colour of the rod tube in the .rrd: {', '.join(COLOR_FIELDS)} "
-                   "(kappa_D0; contact_width = contact_width_fraction)")
+    for name, par in params.items():
+        if name != "knot":
+            p.add_argument(flag(name), **flag_kwargs(par))
     p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>; "
                    "made with its parents under runs/, elsewhere its parent must exist)")
     p.add_argument("--json", metavar="FILE", help="write the summary here instead")
     p.add_argument("--figures", metavar="DIR", help="write the figures here instead")
     p.add_argument("--rrd", metavar="FILE", help="write the rerun log here instead")
-    p.add_argument("--device", default=None, help="Warp device (default cpu)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_tie)
 

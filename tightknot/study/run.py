@@ -291,9 +291,12 @@ def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> 
         d0 = closed[0].scene.diameter
         ideal = analyze_centerline(load_ideal_trefoil(d0), d0, True, contact_tol=0.002)
         for r in closed:
+            # The ideal knot overlaid is the trefoil's: another knot type is drawn alone.
+            ref = ideal if r.scene.knot_type == "3_1" else None
             p1, p2 = folder / "closed_profiles.png", folder / "closed_contact_map.png"
-            figures.plot_closed_profiles(r.report, p1, ideal=ideal, label="elastic rod")
-            figures.plot_contact_map(r.report, p2, ideal=ideal, label="elastic rod")
+            figures.plot_closed_profiles(r.report, p1, ideal=ref, label="elastic rod",
+                                         knot=r.scene.name.replace("_", " "))
+            figures.plot_contact_map(r.report, p2, ideal=ref, label="elastic rod")
             paths += [p1, p2]
     if opened:
         reps, lcs, areas = {}, {}, {}

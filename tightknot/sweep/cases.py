@@ -6,25 +6,14 @@ sorted from the loosest to the tightest (the order the continuation path visits 
 is a hash of that canonical dict, so the same physics always gets the same id, whatever the
 order or spelling in which it was asked for; the store uses the id to skip finished cases.
 
-Parameters (SI units):
-
-* ``knot``: "closed" (the study's closed trefoil) or "open" (overhand knot, pulled).
-* ``knot_type``: "3_1" (trefoil, the study's) or "4_1" (figure-eight; its scenes'
-  default lengths: L0/D0 = 22.1 closed, L0 = 0.30 m open).
-* ``nodes``: vertices (>= 24 closed, >= 40 open; default 200 closed, 300 open).
-* ``diameter`` D0 [m] (8.5e-3), ``youngs_modulus`` E [Pa] (1.25e6), ``poisson`` nu
-  (0.5, in (-1, 0.5]), ``density`` [kg/m^3] (1160; only the proximal fallback uses it).
-* ``contact``: "compliant" (the FEM-calibrated radial-compliance law), "smoothed" (the
-  same law, the section thinned by the stretch averaged over +-1 D0; a sweep with
-  ``--batch`` ties these cases one by one)
-  or "rigid" (the rigid-tube law, 1e3 times stiffer, radius not thinned by stretch).
-* ``twist``: twist dofs on or off (default on for closed, off for open knots: an isotropic
-  rod with twist-free ends relaxes its twist to zero).
-* closed: ``l0_over_d0`` L0/D0 (16.37, >= 10).
-* open: ``length`` L0 [m] (0.185, >= 10 D0) and exactly one level list:
-  ``pull_force`` [N] or ``target_lambda`` (Lambda_OC, physics.md sec. 2), each with at
-  least one value; ``lambda_tolerance`` (0.1) is how close a target is reached.
-* ``residual_tol`` (1e-6): Newton tolerance on the scaled residual; ``tighten_steps`` (40).
+Parameters (SI units): those of :class:`tightknot.study.params.Scene` (knot, knot_type,
+nodes, diameter, youngs_modulus, poisson, density, contact, twist; closed: l0_over_d0;
+open: length) and some of :class:`tightknot.loading.options.LoadPath` (residual_tol,
+tighten_steps; open: lambda_tolerance), with the defaults and ranges declared there (per
+knot: :data:`tightknot.study.params.KNOT_DEFAULTS`); :data:`CASE_KEYS` lists them. An open
+knot has exactly one level list, each level checked as the load it is (:data:`LEVELS`):
+``pull_force`` [N] or ``target_lambda`` (Lambda_OC, physics.md sec. 2), each with at least
+one value. A ``contact="smoothed"`` case is tied one by one under ``--batch``.
 """
 
 from __future__ import annotations
@@ -32,73 +21,65 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
+
+from tightknot.study.params import RUN_PARAMS, check_scene, knot_defaults
 
 #: Prefix of the hashed text: bump it when the meaning of a parameter changes, so that a
 #: store written by an older version is not taken for finished work.
 _ID_SCHEMA = "tightknot-sweep-case-v1"
 
-KNOTS = ("closed", "open")
-CONTACT_LAWS = ("compliant", "smoothed", "rigid")
-LEVEL_KEYS = ("pull_force", "target_lambda")
-
-_COMMON_DEFAULTS: dict[str, Any] = {
-    "diameter": 8.5e-3,
-    "youngs_modulus": 1.25e6,
-    "poisson": 0.5,
-    "density": 1160.0,
-    "contact": "compliant",
-    "residual_tol": 1e-6,
-    "tighten_steps": 40,
+#: The parameters of a case besides its knot and levels, in the order its dict lists them.
+#: The canonical dict holds exactly these: one more would change every case's id.
+CASE_KEYS: dict[str, tuple[str, ...]] = {
+    "closed": ("diameter", "youngs_modulus", "poisson", "density", "contact", "residual_tol",
+               "tighten_steps", "knot_type", "nodes", "twist", "l0_over_d0"),
+    "open": ("diameter", "youngs_modulus", "poisson", "density", "contact", "residual_tol",
+             "tighten_steps", "knot_type", "nodes", "twist", "length", "lambda_tolerance"),
 }
-_DEFAULTS: dict[str, dict[str, Any]] = {
-    "closed": {"knot_type": "3_1", "nodes": 200, "twist": True, "l0_over_d0": None},
-    "open": {"knot_type": "3_1", "nodes": 300, "twist": False, "length": None,
-             "lambda_tolerance": 0.1},
-}
-#: Knot types with a scene (tightknot.knots.scenes), and the default length of each: the
-#: study's trefoils (L0/D0 = 16.37; L0 = 185 mm), the figure-eight scenes' own defaults.
-KNOT_TYPES = ("3_1", "4_1")
-_LENGTH_DEFAULTS = {("closed", "3_1"): 16.37, ("closed", "4_1"): 22.1,
-                    ("open", "3_1"): 0.185, ("open", "4_1"): 0.30}
-_LENGTH_KEY = {"closed": "l0_over_d0", "open": "length"}
+#: Run parameters that are not case parameters, and why: a sweep's path pulls level by
+#: level with its own steps, ties with tie()'s relaxation, has no end-distance levels
+#: (its force levels are ``pull_force``), and writes no pictures; the device is the
+#: sweep's, not the case's.
+NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
+                 "color_by", "device")
+#: Level lists of an open knot -> the load each level is (its range and unit).
+LEVELS = {"pull_force": "force", "target_lambda": "target_lambda"}
+LEVEL_KEYS = tuple(LEVELS)
 
 
 def defaults(knot: str, knot_type: str = "3_1") -> dict[str, Any]:
     """Every parameter's default for a ``knot`` ("closed"/"open") of ``knot_type``."""
-    out = {**_COMMON_DEFAULTS, **_DEFAULTS[knot]}
-    out["knot_type"] = knot_type
-    out[_LENGTH_KEY[knot]] = _LENGTH_DEFAULTS[(knot, knot_type)]
-    return out
-_MIN_NODES = {"closed": 24, "open": 40}
+    per_knot = {"knot_type": knot_type, **knot_defaults(knot, knot_type)}
+    return {k: per_knot[k] if k in per_knot else RUN_PARAMS[k].default for k in CASE_KEYS[knot]}
 
 
-def _number(name: str, value: Any, valid: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ValueError(f"{name} must be a number {valid}, got {value!r}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be a finite number {valid}, got {value!r}")
-    return v
+def _value(key: str, value: Any) -> Any:
+    """A case parameter checked (:meth:`tightknot.loading.options.Param.check`); a whole
+    number spelled as a float is the same case as the int."""
+    p = RUN_PARAMS[key]
+    if value is None:
+        raise ValueError(f"{key}: must not be null ({p.meaning})")
+    if p.kind is int and isinstance(value, float) and value.is_integer():
+        value = int(value)
+    return p.check(value)
 
 
-def _positive(name: str, value: Any, unit: str) -> float:
-    v = _number(name, value, f"> 0 {unit}".rstrip())
-    if v <= 0:
-        raise ValueError(f"{name} must be > 0 {unit}".rstrip() + f", got {value!r}")
-    return v
-
-
-def _levels(name: str, value: Any, unit: str) -> list[float]:
+def _levels(name: str, value: Any) -> list[float]:
+    p = RUN_PARAMS[LEVELS[name]]
     if isinstance(value, int | float) and not isinstance(value, bool):
         value = [value]
     if isinstance(value, str | bytes) or not isinstance(value, Sequence) or len(value) == 0:
-        raise ValueError(f"{name} must be a non-empty list of numbers > 0 {unit}".rstrip()
-                         + f", got {value!r}")
-    out = [_positive(f"{name}[{i}]", v, unit) for i, v in enumerate(value)]
+        u = f" {p.unit}" if p.unit else ""
+        raise ValueError(f"{name} must be a non-empty list of numbers in {p.valid.text()}{u}, "
+                         f"got {value!r}")
+    out = []
+    for i, v in enumerate(value):
+        if v is None:
+            raise ValueError(f"{name}[{i}]: must not be null ({p.meaning})")
+        out.append(p.check(v, f"{name}[{i}]"))
     if len(set(out)) != len(out):
         raise ValueError(f"{name} lists a level twice: {out}")
     return out
@@ -110,74 +91,31 @@ def canonical(params: Mapping[str, Any]) -> dict[str, Any]:
     Raises ValueError naming the parameter and its valid range.
     """
     p = dict(params)
-    knot = p.pop("knot", None)
-    if knot not in KNOTS:
-        raise ValueError(f"knot must be one of {KNOTS}, got {knot!r}")
-    allowed = set(_COMMON_DEFAULTS) | set(_DEFAULTS[knot])
+    if "knot" not in p:
+        raise ValueError("knot: missing (closed or open)")
+    knot = _value("knot", p.pop("knot"))
+    allowed = set(CASE_KEYS[knot])
     if knot == "open":
-        allowed |= set(LEVEL_KEYS)
+        allowed |= set(LEVELS)
     unknown = sorted(set(p) - allowed)
     if unknown:
         raise ValueError(f"unknown parameter(s) {unknown} for a {knot} knot; valid: "
                          f"{sorted(allowed)}")
-    knot_type = p.get("knot_type", "3_1")
-    if knot_type not in KNOT_TYPES:
-        raise ValueError(f"knot_type must be one of {KNOT_TYPES}, got {knot_type!r}")
+    knot_type = _value("knot_type", p.get("knot_type", RUN_PARAMS["knot_type"].default))
     out: dict[str, Any] = {"knot": knot}
     for key, default in defaults(knot, knot_type).items():
-        out[key] = p.get(key, default)
-    nodes = out["nodes"]
-    if isinstance(nodes, bool) or not isinstance(nodes, int | float) or nodes != int(nodes) \
-            or nodes < _MIN_NODES[knot]:
-        raise ValueError(f"nodes must be a whole number >= {_MIN_NODES[knot]} for a {knot} "
-                         f"knot, got {nodes!r}")
-    out["nodes"] = int(nodes)
-    out["diameter"] = _positive("diameter", out["diameter"], "m")
-    out["youngs_modulus"] = _positive("youngs_modulus", out["youngs_modulus"], "Pa")
-    nu = _number("poisson", out["poisson"], "in (-1, 0.5]")
-    if not -1.0 < nu <= 0.5:
-        raise ValueError(f"poisson must be in (-1, 0.5], got {out['poisson']!r}")
-    out["poisson"] = nu
-    rho = _number("density", out["density"], ">= 0 kg/m^3")
-    if rho < 0:
-        raise ValueError(f"density must be >= 0 kg/m^3, got {out['density']!r}")
-    out["density"] = rho
-    if out["contact"] not in CONTACT_LAWS:
-        raise ValueError(f"contact must be one of {CONTACT_LAWS}, got {out['contact']!r}")
-    if not isinstance(out["twist"], bool):
-        raise ValueError(f"twist must be true or false, got {out['twist']!r}")
-    tol = _positive("residual_tol", out["residual_tol"], "")
-    if tol >= 1e-2:
-        raise ValueError(f"residual_tol must be in (0, 1e-2), got {out['residual_tol']!r}")
-    out["residual_tol"] = tol
-    steps = out["tighten_steps"]
-    if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= 10000:
-        raise ValueError(f"tighten_steps must be a whole number in [1, 10000], got {steps!r}")
+        out[key] = _value(key, p.get(key, default))
+    check_scene(out)
     if knot == "closed":
-        ratio = _positive("l0_over_d0", out["l0_over_d0"], "")
-        if ratio < 10.0:
-            raise ValueError(f"l0_over_d0 must be >= 10 (a trefoil needs 16.37 when ideal), "
-                             f"got {out['l0_over_d0']!r}")
-        out["l0_over_d0"] = ratio
         return out
-    out["length"] = _positive("length", out["length"], "m")
-    if out["length"] < 10.0 * out["diameter"]:
-        raise ValueError(f"length must be >= 10 D0 = {10 * out['diameter']:.4g} m for an open "
-                         f"trefoil, got {out['length']!r}")
-    lt = _positive("lambda_tolerance", out["lambda_tolerance"], "")
-    out["lambda_tolerance"] = lt
-    given = [k for k in LEVEL_KEYS if p.get(k) is not None]
+    given = [k for k in LEVELS if p.get(k) is not None]
     if len(given) != 1:
         raise ValueError("an open knot needs exactly one level list: pull_force [N] or "
                          f"target_lambda (Lambda_OC), got {given or 'none'}")
     key = given[0]
-    if key == "pull_force":
-        out[key] = sorted(_levels(key, p[key], "N"))  # loosest (weakest pull) first
-    else:
-        lams = _levels(key, p[key], "")
-        if max(lams) >= 1e3:
-            raise ValueError(f"target_lambda must be < 1000, got {max(lams)!r}")
-        out[key] = sorted(lams, reverse=True)  # loosest (longest knot) first
+    levels = _levels(key, p[key])
+    # Loosest first: the weakest pull, the longest knot.
+    out[key] = sorted(levels) if key == "pull_force" else sorted(levels, reverse=True)
     return out
 
 

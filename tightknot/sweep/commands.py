@@ -28,7 +28,7 @@ _EXAMPLES = """examples:
   tightknot sweep closed --l0-over-d0 16.37 18 20 --out runs/c --executor dask \\
       --scheduler tcp://scheduler:8786
   # eight closed trefoils tied together in one model, in this process
-  tightknot sweep closed --l0-over-d0 17 17.5 18 18.5 19 19.5 20 20.5 --nodes 100 \
+  tightknot sweep closed --l0-over-d0 17 17.5 18 18.5 19 19.5 20 20.5 --nodes 100 \\
       --batch 8 --executor serial --out runs/cb
   # interrupted? run the same command again: finished cases are skipped
   tightknot sweep closed --l0-over-d0 16.37 18 20 --out runs/c --json runs/c.json
@@ -37,17 +37,30 @@ store: DIR/index.json lists every case (id, params, status); DIR/cases/ID.json h
 record (the knot summary of 'tightknot tie'; for an open knot one entry per level).
 """
 
-#: Command-line option -> case parameter, for the options that may be sweep axes.
-_AXES = {
-    "nodes": "nodes", "diameter": "diameter", "youngs_modulus": "youngs_modulus",
-    "poisson": "poisson", "contact": "contact", "l0_over_d0": "l0_over_d0",
-    "length": "length", "knot_type": "knot_type",
-}
+
+
+def _options() -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(axes, single): the case parameters that are sweep axes (the scene's: several values
+    are their product) and those given once (the load path's)."""
+    from tightknot.loading.options import parameters
+    from tightknot.study.params import Scene
+    from tightknot.sweep.cases import CASE_KEYS
+
+    axes = tuple(k for k in parameters(Scene) if k != "knot")
+    keys = dict.fromkeys(CASE_KEYS["closed"] + CASE_KEYS["open"])
+    return axes, tuple(k for k in keys if k not in axes)
+
+
+#: The flag of each level list (the loads' own names are the tie command's).
+_LEVEL_FLAGS = {"target_lambda": "--lambda", "pull_force": "--force"}
 
 
 def register(subparsers: Any) -> None:
-    """Add ``tightknot sweep`` to an argparse ``subparsers``."""
-    from tightknot.sweep.cases import CONTACT_LAWS
+    """Add ``tightknot sweep`` to an argparse ``subparsers``; the case parameters' flags
+    are generated from their declarations (:mod:`tightknot.study.params`)."""
+    from tightknot.loading.options import flag, flag_kwargs
+    from tightknot.study.params import RUN_PARAMS
+    from tightknot.sweep.cases import LEVELS
     from tightknot.sweep.executors import EXECUTORS
 
     p = subparsers.add_parser(
@@ -57,38 +70,22 @@ def register(subparsers: Any) -> None:
         "file per case in --out, written atomically, with an index; an interrupted sweep "
         "started again skips the finished cases.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("knot", choices=["closed", "open"], help="closed or open trefoil")
-    p.add_argument("--knot-type", nargs="+", choices=["3_1", "4_1"],
-                   help="trefoil 3_1 (the study's, default) and/or figure-eight 4_1")
+    knot = RUN_PARAMS["knot"]
+    p.add_argument("knot", choices=knot.valid, help=knot.what)
     p.add_argument("--out", required=True, metavar="DIR",
                    help="the store folder (created; its parent must exist)")
-    p.add_argument("--l0-over-d0", type=float, nargs="+", metavar="R",
-                   help="closed: L0/D0 values (16.37; figure-eight 22.1)")
-    p.add_argument("--length", type=float, nargs="+", metavar="L0",
-                   help="open: rest lengths L0 [m] (0.185; figure-eight 0.30)")
+    axes, single = _options()
+    for name in axes:
+        p.add_argument(flag(name), **flag_kwargs(RUN_PARAMS[name], nargs="+"))
     levels = p.add_mutually_exclusive_group()
-    levels.add_argument("--lambda", dest="target_lambda", type=float, nargs="+",
-                        metavar="LAMBDA", help="open: target knot lengths Lambda_OC, "
-                        "one path visiting them from the loosest")
-    levels.add_argument("--force", dest="pull_force", type=float, nargs="+", metavar="F",
-                        help="open: pulling forces [N], one path from the weakest")
-    p.add_argument("--lambda-tolerance", type=float, default=None,
-                   help="open: how close a --lambda level is reached (0.1)")
-    p.add_argument("--nodes", type=int, nargs="+", help="vertices (200 closed, 300 open)")
-    p.add_argument("--diameter", type=float, nargs="+", help="rest diameter D0 [m] (8.5e-3)")
-    p.add_argument("--youngs-modulus", type=float, nargs="+", metavar="E",
-                   help="Young's modulus E [Pa] (1.25e6)")
-    p.add_argument("--poisson", type=float, nargs="+", metavar="NU",
-                   help="Poisson ratio in (-1, 0.5] (0.5)")
-    p.add_argument("--contact", nargs="+", choices=CONTACT_LAWS,
-                   help="contact law: compliant (FEM-calibrated) and/or rigid (rigid tube)")
-    p.add_argument("--twist", nargs="+", choices=["on", "off"],
-                   help="twist dofs (default on for closed, off for open knots: an isotropic "
-                   "rod with twist-free ends relaxes its twist to zero)")
-    p.add_argument("--residual-tol", type=float, default=None,
-                   help="Newton tolerance on the scaled residual (1e-6)")
-    p.add_argument("--tighten-steps", type=int, default=None,
-                   help="initial load steps of the tightening (40)")
+    what = {"target_lambda": ("open: target knot lengths Lambda_OC", ", one path visiting "
+                              "them from the loosest"),
+            "pull_force": ("open: pulling forces", ", one path from the weakest")}
+    for name, load in LEVELS.items():
+        levels.add_argument(_LEVEL_FLAGS[name], dest=name, **flag_kwargs(
+            RUN_PARAMS[load], nargs="+", what=what[name][0], note=what[name][1]))
+    for name in single:
+        p.add_argument(flag(name), **flag_kwargs(RUN_PARAMS[name]))
     p.add_argument("--executor", choices=EXECUTORS, default="process",
                    help="where cases run: local processes (default), serial (this "
                    "process), dask (a local cluster, or --scheduler)")
@@ -103,37 +100,30 @@ def register(subparsers: Any) -> None:
     p.add_argument("--retry-failed", action="store_true",
                    help="run again the cases stored as failed")
     p.add_argument("--json", metavar="FILE", help="write a summary of every case as JSON")
-    p.add_argument("--device", default=None, help="Warp device (default cpu)")
+    p.add_argument("--device", **flag_kwargs(RUN_PARAMS["device"]))
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=run_command)
 
 
 def build_cases(args: argparse.Namespace) -> list:
     """The sweep's cases from the parsed options (ValueError on bad input)."""
-    from tightknot.sweep.cases import grid
+    from tightknot.loading.options import flag
+    from tightknot.sweep.cases import CASE_KEYS, LEVELS, grid
 
-    if args.knot == "closed":
-        bad = [o for o, v in (("--length", args.length), ("--lambda", args.target_lambda),
-                              ("--force", args.pull_force),
-                              ("--lambda-tolerance", args.lambda_tolerance)) if v is not None]
-        if bad:
-            raise ValueError(f"{', '.join(bad)}: for open knots only")
-    else:
-        if args.l0_over_d0 is not None:
-            raise ValueError("--l0-over-d0 is for closed knots (open knots: --length)")
-        if args.target_lambda is None and args.pull_force is None:
-            raise ValueError("an open knot needs its levels: --lambda LAMBDA... or --force "
-                             "F... [N]")
+    axes, single = _options()
+    given = [k for k in (*axes, *LEVELS, *single) if getattr(args, k) is not None]
+    allowed = set(CASE_KEYS[args.knot]) | (set(LEVELS) if args.knot == "open" else set())
+    foreign = [k for k in given if k not in allowed]
+    if foreign:
+        other = "open" if args.knot == "closed" else "closed"
+        names = ", ".join(_LEVEL_FLAGS.get(k, flag(k)) for k in foreign)
+        raise ValueError(f"{names}: for {other} knots only")
+    if args.knot == "open" and not any(k in given for k in LEVELS):
+        raise ValueError("an open knot needs its levels: --lambda LAMBDA... or --force "
+                         "F... [N]")
     base: dict[str, Any] = {"knot": args.knot}
-    for opt in ("target_lambda", "pull_force", "lambda_tolerance", "residual_tol",
-                "tighten_steps"):
-        if getattr(args, opt) is not None:
-            base[opt] = getattr(args, opt)
-    axes = {param: getattr(args, opt) for opt, param in _AXES.items()
-            if getattr(args, opt) is not None}
-    if args.twist is not None:
-        axes["twist"] = [v == "on" for v in args.twist]
-    return grid(base, **axes)
+    base.update({k: getattr(args, k) for k in given if k not in axes})
+    return grid(base, **{k: getattr(args, k) for k in given if k in axes})
 
 
 def short_result(record: dict[str, Any]) -> dict[str, Any]:

@@ -14,13 +14,11 @@ import platform
 import time
 import traceback
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from tightknot.study.params import build_scene
 from tightknot.sweep.cases import Case
 from tightknot.sweep.store import ERROR, FAILED, OK
-
-if TYPE_CHECKING:
-    from tightknot.knots.scenes import KnotScene
 
 #: Keys of a record that depend on the machine, the moment and how the case was run (alone
 #: or in a batch), not on the physics.
@@ -39,19 +37,6 @@ def batch_key(params: Mapping[str, Any]) -> tuple | None:
     if params["knot"] != "closed" or params.get("contact") == "smoothed":
         return None
     return tuple(params[k] for k in BATCH_KEYS)
-
-
-def build_scene(params: Mapping[str, Any], device: str = "cpu") -> KnotScene:
-    """The :class:`~tightknot.knots.scenes.KnotScene` of canonical case ``params``."""
-    from tightknot.knots import scenes
-    from tightknot.rods.material import Material
-
-    material = Material(params["youngs_modulus"], params["poisson"], params["density"])
-    name = {"3_1": "trefoil", "4_1": "figure_eight"}[params["knot_type"]]
-    make = getattr(scenes, f"{params['knot']}_{name}")
-    length = params["l0_over_d0"] if params["knot"] == "closed" else params["length"]
-    return make(length, params["diameter"], params["nodes"], material, twist=params["twist"],
-                contact=params["contact"], device=device)
 
 
 def solve_case(case: Case, device: str = "cpu") -> dict[str, Any]:

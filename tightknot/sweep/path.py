@@ -38,6 +38,7 @@ from tightknot.knots.scenes import (
     gauge,
     vertex_radii,
 )
+from tightknot.loading.options import LoadPath
 from tightknot.loading.tie import TieResult, end_reaction, knot_type_of, tie
 from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.system import RodSystem
@@ -356,9 +357,9 @@ def tightness_path(
     scene: KnotScene,
     pull_force: list[float] | None = None,
     target_lambda: list[float] | None = None,
-    lambda_tolerance: float = 0.1,
-    residual_tol: float = 1e-6,
-    tighten_steps: int = 40,
+    lambda_tolerance: float = LoadPath.lambda_tolerance,
+    residual_tol: float = LoadPath.residual_tol,
+    tighten_steps: int = LoadPath.tighten_steps,
     proximal_steps: int = 60,
     predictor: bool = True,
     on_level: Callable[[LevelResult], None] | None = None,

@@ -53,9 +53,10 @@ def _closed_kappa(rep: Mapping[str, Any]) -> np.ndarray:
 
 def plot_closed_profiles(
     report: Mapping[str, Any], path: str | os.PathLike[str],
-    ideal: Mapping[str, Any] | None = None, label: str = "knot",
+    ideal: Mapping[str, Any] | None = None, label: str = "knot", knot: str = "closed trefoil",
 ) -> None:
-    """rho(s), z(s), kappa D0 (s) of a closed knot, the ideal knot overlaid if given."""
+    """rho(s), z(s), kappa D0 (s) of a closed knot (named ``knot`` in the title), the ideal
+    knot overlaid if given."""
     fig, axes = plt.subplots(3, 1, figsize=(7, 8), sharex=True)
     series = [("rho", r"$\rho = \sqrt{X^2+Y^2}/D_0$"), ("z", r"$z = Z/D_0$"),
               ("kappa", r"$\kappa D_0$")]
@@ -72,7 +73,7 @@ def plot_closed_profiles(
     axes[2].axhline(2.0, color="0.5", linewidth=0.8, linestyle=":")
     axes[2].text(axes[2].get_xlim()[0], 2.0, " active limit 2", va="bottom", color="0.4")
     axes[0].legend(loc="upper right")
-    axes[0].set_title("closed trefoil (grey lines: inner segments)")
+    axes[0].set_title(f"{knot} (grey lines: inner segments)")
     axes[2].set_xlabel(r"$s = S/L \cdot L_0/D_0$")
     save_png_atomic(fig, path)
 

@@ -1,0 +1,153 @@
+"""The parameters of a knot run, declared once: the scene, the load path and the outputs.
+
+:class:`Scene` (which knot, its rod and its contact model), :class:`tightknot.loading.options.
+LoadPath` (how it is tied) and :class:`Output` (what the run writes) each list their fields
+with default, valid range, unit and meaning (:func:`tightknot.loading.options.param`). The
+``tightknot tie`` config and flags (:mod:`tightknot.app.config`) and the sweep's cases and
+flags (:mod:`tightknot.sweep.cases`, :mod:`tightknot.sweep.commands`) are generated from them.
+
+Defaults that depend on the knot (its length, vertex count and twist) are the table
+:data:`KNOT_DEFAULTS`; a field whose default is None there is resolved from it per knot.
+SI units throughout.
+"""
+
+from __future__ import annotations
+
+import types
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from tightknot.loading.options import LoadPath, Range, format_value, param, parameters
+from tightknot.viz.rerun_log import ROD_FIELDS
+
+if TYPE_CHECKING:
+    from tightknot.knots.scenes import KnotScene
+
+KNOTS = ("closed", "open")
+#: Knot types with a scene (tightknot.knots.scenes), and the scene's name of each.
+KNOT_TYPES = ("3_1", "4_1")
+SCENE_NAMES = {"3_1": "trefoil", "4_1": "figure_eight"}
+#: Contact levels that can tie a knot (tightknot.knots.scenes.CONTACT_LEVELS less "off").
+CONTACT_LEVELS = ("compliant", "smoothed", "rigid")
+
+#: Defaults that depend on the knot, (knot, knot_type) -> {key: value}: the study's trefoils
+#: (L0/D0 = 16.37; L0 = 185 mm) and the figure-eight scenes' own lengths; twist off for
+#: open knots (an isotropic rod with twist-free ends relaxes its twist to zero).
+KNOT_DEFAULTS: Mapping[tuple[str, str], Mapping[str, Any]] = types.MappingProxyType({
+    ("closed", "3_1"): {"l0_over_d0": 16.37, "nodes": 200, "twist": True},
+    ("closed", "4_1"): {"l0_over_d0": 22.1, "nodes": 200, "twist": True},
+    ("open", "3_1"): {"length": 0.185, "nodes": 300, "twist": False},
+    ("open", "4_1"): {"length": 0.30, "nodes": 300, "twist": False},
+})
+#: Fewest vertices of a knot's scene (tightknot.knots.scenes refuses fewer).
+MIN_NODES = {"closed": 24, "open": 40}
+
+#: Fields a rod tube may be coloured by in the .rrd (the logger's).
+COLOR_FIELDS = tuple(ROD_FIELDS)
+#: Short aliases accepted for ``color_by`` (the CLI's spelling of the issue's field names).
+COLOR_ALIASES = {"contact_width": "contact_width_fraction"}
+
+
+def _knot_default_text(key: str) -> str:
+    """``--help``'s default of a per-knot parameter, from :data:`KNOT_DEFAULTS`
+    (e.g. "200 closed, 300 open"; "16.37 for 3_1, 22.1 for 4_1")."""
+    per_knot = {knot: {t: KNOT_DEFAULTS[(knot, t)][key] for t in KNOT_TYPES
+                       if key in KNOT_DEFAULTS[(knot, t)]} for knot in KNOTS}
+    per_knot = {knot: v for knot, v in per_knot.items() if v}
+    parts = []
+    for knot, values in per_knot.items():
+        where = f" {knot}" if len(per_knot) > 1 else ""
+        if len(set(values.values())) == 1:
+            parts.append(f"{format_value(next(iter(values.values())))}{where}")
+        else:
+            parts += [f"{format_value(v)}{where} for {t}" for t, v in values.items()]
+    return ", ".join(parts)
+
+
+# Ranges bound what the model can mean physically or what the machine can hold, not what
+# the study used: a run outside the study is allowed, a negative length or a 10^9-vertex
+# rod is not.
+@dataclass(frozen=True)
+class Scene:
+    """The knot scene of a run (SI units): which knot, its rod and its contact model
+    (tightknot.knots.scenes: what each contact level and ``twist`` neglect)."""
+
+    knot: str = param(valid=KNOTS, what="closed or open knot")
+    knot_type: str = param("3_1", KNOT_TYPES, "",
+                           "knot type: 3_1 trefoil (the study's) or 4_1 figure-eight")
+    l0_over_d0: float | None = param(None, Range(10.0, 1e4), "",
+                                     "rest length over diameter L0/D0", only="closed",
+                                     default_text=_knot_default_text("l0_over_d0"),
+                                     metavar="R")
+    length: float | None = param(None, Range(0.0, 100.0, low_open=True), "m",
+                                 "rest length L0", only="open",
+                                 default_text=_knot_default_text("length"), metavar="L0")
+    nodes: int | None = param(None, Range(24, 200_000), "", "vertices of the rod",
+                              default_text=_knot_default_text("nodes"))
+    diameter: float = param(8.5e-3, Range(0.0, 1.0, low_open=True), "m", "rest diameter D0",
+                            metavar="D0")
+    youngs_modulus: float = param(1.25e6, Range(0.0, 1e12, low_open=True), "Pa",
+                                  "Young's modulus E", metavar="E")
+    poisson: float = param(0.5, Range(-1.0, 0.5, low_open=True), "", "Poisson ratio nu",
+                           metavar="NU")
+    # Statics does not depend on the density; only the proximal steps that carry a solve
+    # through a limit point do.
+    density: float = param(1160.0, Range(0.0, 1e5), "kg/m^3", "mass density", metavar="RHO")
+    contact: str = param("compliant", CONTACT_LEVELS, "",
+                         "contact level: compliant (the FEM-calibrated law), smoothed "
+                         "(sections thinned by the stretch averaged over +-1 D0), rigid "
+                         "(a rigid tube)")
+    twist: bool | None = param(None, None, "", "twist dofs",
+                               default_text=_knot_default_text("twist"))
+
+
+@dataclass(frozen=True)
+class Output:
+    """What a run writes besides its numbers, and where it runs."""
+
+    color_by: str = param("kappa_D0", COLOR_FIELDS, "", "field colouring the rod tube in the "
+                          ".rrd", aliases=COLOR_ALIASES, metavar="FIELD")
+    device: str | None = param(None, None, "", "Warp device, e.g. cpu or cuda:0",
+                               default_text="cpu")
+
+
+#: Every run parameter by name: the scene's, the load path's and the outputs'.
+RUN_PARAMS = types.MappingProxyType({**parameters(Scene), **parameters(LoadPath),
+                                     **parameters(Output)})
+
+
+def knot_defaults(knot: str, knot_type: str = "3_1") -> dict[str, Any]:
+    """The defaults of ``knot`` ("closed"/"open") of ``knot_type`` that depend on it."""
+    return dict(KNOT_DEFAULTS[(knot, knot_type)])
+
+
+def check_scene(values: Mapping[str, Any]) -> None:
+    """The rules between a scene's checked parameters (``values``: the knot and what is
+    given): the fewest vertices of the knot, the tails of an open knot. ValueError naming
+    the parameter."""
+    knot = values["knot"]
+    nodes = values.get("nodes")
+    if nodes is not None and nodes < MIN_NODES[knot]:
+        p = RUN_PARAMS["nodes"]
+        raise ValueError(f"nodes: {nodes!r} is out of range for {knot} knots; valid: "
+                         f"[{MIN_NODES[knot]}, {p.valid.high:g}] ({p.meaning})")
+    length = values.get("length")
+    if knot == "open" and length is not None:
+        d0 = values.get("diameter", Scene.diameter)
+        if length < 10.0 * d0:
+            raise ValueError(f"length must be >= 10 D0 = {10 * d0:.4g} m for an open knot, got "
+                             f"{length!r}")
+
+
+def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
+    """The :class:`~tightknot.knots.scenes.KnotScene` of resolved scene parameters
+    ``values`` (every :class:`Scene` field of its knot given; other keys are ignored)."""
+    from tightknot.knots import scenes
+    from tightknot.rods.material import Material
+
+    material = Material(values["youngs_modulus"], values["poisson"], values["density"])
+    make = getattr(scenes, f"{values['knot']}_{SCENE_NAMES[values['knot_type']]}")
+    length = values["l0_over_d0"] if values["knot"] == "closed" else values["length"]
+    return make(length, values["diameter"], values["nodes"], material, twist=values["twist"],
+                contact=values["contact"], device=device)
