@@ -10,8 +10,9 @@ from tightknot.sweep.execute import run_case
 
 
 def test_levels_along_one_path_and_an_unreachable_level_reported() -> None:
-    # 90 vertices: about the fewest the 185 mm scene accepts (edges <= pi/4 D0).
-    rec = run_case({"knot": "open", "nodes": 90, "tighten_steps": 20,
+    # 90 vertices: about the fewest the 185 mm scene accepts (edges <= pi/4 D0). Hinged
+    # ends (no grips), so that the weakest level cannot be reached.
+    rec = run_case({"knot": "open", "nodes": 90, "tighten_steps": 20, "grip_length": 0.0,
                     "pull_force": [4.0, 0.3, 3.0]})
     res = rec["result"]
     levels = res["levels"]
@@ -42,6 +43,16 @@ def test_levels_along_one_path_and_an_unreachable_level_reported() -> None:
     # Each level's profiles are stored (curvature and centerline of every vertex).
     assert len(levels[2]["summary"]["centerline_m"]) == 90
     assert [row["target"] for row in res["table"]] == [0.3, 3.0, 4.0]
+
+
+def test_grips_hold_a_gentle_pull_that_hinged_ends_lose() -> None:
+    # The same weakest level with the tails held on the pull axis (the default grips of
+    # 1 D0): the loose knot cannot swing an end out of its loop and stays a trefoil.
+    rec = run_case({"knot": "open", "nodes": 90, "tighten_steps": 20, "pull_force": [0.3]})
+    (level,) = rec["result"]["levels"]
+    assert level["reached"], level["failure"]
+    assert level["summary"]["knot_type"] == "3_1"
+    assert rec["result"]["knot_types"] == ["3_1"]
 
 
 @pytest.mark.slow

@@ -83,6 +83,15 @@ CONTACT_LEVELS = ("compliant", "smoothed", "rigid", "off")
 #: docs/fem_crosscheck.md.
 SMOOTHED_RADIUS_WINDOW = 1.0
 
+#: Length [D0] of each tail held on the pull axis by a grip (open knots), as the clamps of
+#: a tensile test hold a rope: the ends cannot swing, so a frictionless knot that drifts
+#: toward an end meets a straight, held tail instead of a hinge it can slip over.
+GRIP_LENGTH = 1.0
+
+#: Twist in the grips of an open rod with twist dofs: "free" (the rod may spin about the
+#: pull axis inside the grip) or "clamped" (its material frame held).
+GRIP_TWIST = ("free", "clamped")
+
 #: Length over diameter of the ideal (tightest rigid-tube) closed knots: trefoil 16.3715
 #: (Przybyl & Pieranski 2014), figure-eight 21.0415 (Ashton, Cantarella, Piatek, Rawdon 2011).
 IDEAL_L_OVER_D = {"3_1": 16.3715, "4_1": 21.0415}
@@ -302,7 +311,7 @@ def closed_figure_eight(
 def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter: float,
                nodes: int, material: Material | None, law: RadialComplianceLaw | None,
                twist: bool, contact: str, device: str, tail_fraction: float,
-               clearance: float, corner_std: float,
+               clearance: float, corner_std: float, grip_length: float, grip_twist: str,
                corner_window: float | None = None) -> KnotScene:
     """An open knot with straight tails from ``curve_fn(n, size, tail)`` (a curves.open_*
     helper; module docstring and :func:`open_trefoil`); ``corner_std``: std of the Gaussian
@@ -317,6 +326,14 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
     if not isinstance(tail_fraction, (int, float, np.floating)) or not (
             0.05 <= tail_fraction <= 0.45):
         raise ValueError(f"tail_fraction must be in [0.05, 0.45], got {tail_fraction!r}")
+    # A grip may hold at most a quarter of the rod at each end (the knot needs the rest).
+    grip_max = 0.25 * l0 / d0
+    if not (isinstance(grip_length, (int, float, np.floating)) and math.isfinite(grip_length)
+            and 0.0 <= grip_length <= grip_max):
+        raise ValueError(f"grip_length must be in [0, {grip_max:.3g}] D0 (a quarter of the rod), "
+                         f"got {grip_length!r}")
+    if grip_twist not in GRIP_TWIST:
+        raise ValueError(f"grip_twist must be one of {', '.join(GRIP_TWIST)}, got {grip_twist!r}")
     # The core of the helper curve is ~26 size units long (trefoil); tails of tail * size each.
     core = curve_fn(4000, 1.0, 0.0)
     lc = float(np.linalg.norm(np.diff(core, axis=0), axis=1).sum())
@@ -361,9 +378,14 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
     model = b.finalize(device)
     state = State.initial(model)
     layer = contact_layer(model, contact, law)
+    # The grip holds the end vertex and every vertex within grip_length of it in rest arc
+    # length at L0 (equal edges of l0 / (n - 1)).
+    grip = 1 + int(math.floor(grip_length * d0 * (n - 1) / l0 + 1e-9))
     return KnotScene(name, model, state, layer, d0, l0, False, grow,
                      np.array([1.0, 0.0, 0.0]), knot_type=knot_type,
                      info={"gauge_vertex": far, "tail_fraction": tail_fraction,
+                           "grip_length": float(grip_length), "grip_vertices": grip,
+                           "grip_twist": grip_twist,
                            "model": {"twist": twist, "contact": contact}})
 
 
@@ -378,9 +400,13 @@ def open_trefoil(
     tail_fraction: float = 0.2,
     clearance: float = 1.02,
     contact: str = "compliant",
+    grip_length: float = GRIP_LENGTH,
+    grip_twist: str = "free",
 ) -> KnotScene:
     """The study's open trefoil (overhand knot) of rest length L0 with straight tails along
-    the x axis (the pull axis); its first end is pinned, its last end slides along x.
+    the x axis (the pull axis); its first end is pinned, its last end slides along x, and
+    the last ``grip_length`` D0 of each tail is held on the axis (a grip; 0: hinged ends),
+    the rod free to spin in it about the axis or not (``grip_twist``, with twist dofs).
 
     ``twist=False`` by default: an isotropic rod with twist-free ends relaxes its twist to
     zero, so the twist dofs change nothing (model only what the scene requires).
@@ -388,7 +414,7 @@ def open_trefoil(
     """
     return _open_knot("open_trefoil", "3_1", curves.open_trefoil, rest_length, diameter,
                       nodes, material, law, twist, contact, device, tail_fraction, clearance,
-                      corner_std=0.5)
+                      corner_std=0.5, grip_length=grip_length, grip_twist=grip_twist)
 
 
 def open_figure_eight(
@@ -402,6 +428,8 @@ def open_figure_eight(
     tail_fraction: float = 0.2,
     clearance: float = 1.02,
     contact: str = "compliant",
+    grip_length: float = GRIP_LENGTH,
+    grip_twist: str = "free",
 ) -> KnotScene:
     """An open figure-eight knot (4_1) of rest length L0 with straight tails along the x
     axis, built, held and pulled like :func:`open_trefoil`. Default L0 = 0.30 m (35 D0):
@@ -416,7 +444,8 @@ def open_figure_eight(
     # corners; the knot type stays 4_1).
     return _open_knot("open_figure_eight", "4_1", curves.open_figure_eight, rest_length,
                       diameter, nodes, material, law, twist, contact, device, tail_fraction,
-                      clearance, corner_std=2.0, corner_window=5.0)
+                      clearance, corner_std=2.0, grip_length=grip_length,
+                      grip_twist=grip_twist, corner_window=5.0)
 
 
 def gauge(scene: KnotScene, positions: np.ndarray | None = None,
@@ -424,7 +453,10 @@ def gauge(scene: KnotScene, positions: np.ndarray | None = None,
     """The scene's force-free gauge (module docstring) at ``positions`` (default the start):
     first vertex pinned; closed knots fix two more vertices' coordinates that a rigid
     rotation would move and the uniform twist; open knots let the last end slide along the
-    pull axis (``sliding_end``) and fix the z of the vertex farthest from the axis."""
+    pull axis (``sliding_end``; else the caller pins it), fix the z of the vertex farthest
+    from the axis, and hold their grips: the vertices of the last ``grip_length`` D0 of each
+    tail on the pull axis (y = z = 0, written into the state at every load step; their
+    twist too when ``grip_twist`` is "clamped")."""
     model = scene.model
     bcs = BoundaryConditions(model, positions).pin(0, 0)
     if scene.closed:
@@ -436,6 +468,13 @@ def gauge(scene: KnotScene, positions: np.ndarray | None = None,
     if sliding_end:
         bcs.fix_components(0, -1, (1, 2))
     bcs.fix_components(0, scene.info["gauge_vertex"], (2,))
+    n = model.vertex_count
+    grip = scene.info.get("grip_vertices", 1)
+    for v in (*range(1, grip), *range(n - grip, n - 1)):
+        bcs.hold_components(0, v, (1, 2), (0.0, 0.0))
+    if model.twist and scene.info.get("grip_twist") == "clamped" and grip > 1:
+        for e in (*range(grip - 1), *range(n - grip, n - 1)):
+            bcs.fix_twist(0, e)
     return bcs
 
 

@@ -76,6 +76,7 @@ class BoundaryConditions:
         self._pins: list[_Pin] = []
         self._fixed_twist: list[int] = []
         self._components: list[tuple[int, tuple[int, ...]]] = []
+        self._held: list[tuple[int, tuple[int, ...], np.ndarray]] = []
         self._forces: list[tuple[int, PathVec]] = []
         self._rest_scale: list[tuple[np.ndarray, Callable[[float], float]]] = []
 
@@ -142,6 +143,21 @@ class BoundaryConditions:
             raise ValueError(
                 f"components must be a non-empty subset of (0, 1, 2), got {components}")
         self._components.append((v, comps))
+        return self
+
+    def hold_components(
+        self, rod: int = 0, vertex: int = 0, components: tuple[int, ...] = (1, 2),
+        values: tuple[float, ...] | np.ndarray = (0.0, 0.0),
+    ) -> BoundaryConditions:
+        """Fix some coordinates of a vertex at given ``values`` [m], written into the state
+        at every load step: a vertex held on an axis, as a grip holds a rod's tail."""
+        self.fix_components(rod, vertex, components)
+        vals = np.asarray(values, dtype=np.float64).reshape(-1)
+        if vals.size != len(self._components[-1][1]) or not np.isfinite(vals).all():
+            raise ValueError(f"values must be {len(self._components[-1][1])} finite numbers "
+                             f"(one per component), got {values!r}")
+        v, comps = self._components[-1]
+        self._held.append((v, comps, vals))
         return self
 
     def fix_twist(self, rod: int = 0, edge: int = 0) -> BoundaryConditions:
@@ -226,6 +242,8 @@ class BoundaryConditions:
                 x[v] = pivot + tr + rot @ (c.x0[k] - pivot)
         for p in self._pins:
             x[p.vertex] = p.x0 + (p.translation(t) if p.translation else 0.0)
+        for v, comps, vals in self._held:
+            x[v, list(comps)] = vals
 
     def prescribe_twist(
         self, t: float, theta: np.ndarray, d1_ref: np.ndarray, t_ref: np.ndarray

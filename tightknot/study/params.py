@@ -100,6 +100,12 @@ class Scene:
                          "(a rigid tube)")
     twist: bool | None = param(None, None, "", "twist dofs",
                                default_text=_knot_default_text("twist"))
+    grip_length: float = param(1.0, Range(0.0, 1e3), "D0",
+                               "length of each tail held on the pull axis by a grip "
+                               "(0: hinged ends)", only="open", metavar="LG")
+    grip_twist: str = param("free", ("free", "clamped"), "",
+                            "the rod in a grip: free to spin about the pull axis, or "
+                            "clamped (with twist dofs)", only="open")
 
 
 @dataclass(frozen=True)
@@ -149,5 +155,7 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     material = Material(values["youngs_modulus"], values["poisson"], values["density"])
     make = getattr(scenes, f"{values['knot']}_{SCENE_NAMES[values['knot_type']]}")
     length = values["l0_over_d0"] if values["knot"] == "closed" else values["length"]
+    grips = ({"grip_length": values["grip_length"], "grip_twist": values["grip_twist"]}
+             if values["knot"] == "open" else {})
     return make(length, values["diameter"], values["nodes"], material, twist=values["twist"],
-                contact=values["contact"], device=device)
+                contact=values["contact"], device=device, **grips)

@@ -37,7 +37,8 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
     "closed": ("diameter", "youngs_modulus", "poisson", "density", "contact", "residual_tol",
                "tighten_steps", "knot_type", "nodes", "twist", "l0_over_d0"),
     "open": ("diameter", "youngs_modulus", "poisson", "density", "contact", "residual_tol",
-             "tighten_steps", "knot_type", "nodes", "twist", "length", "lambda_tolerance"),
+             "tighten_steps", "knot_type", "nodes", "twist", "length", "lambda_tolerance",
+             "grip_length", "grip_twist"),
 }
 #: Run parameters that are not case parameters, and why: a sweep's path pulls level by
 #: level with its own steps, ties with tie()'s relaxation, has no end-distance levels
