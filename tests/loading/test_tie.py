@@ -127,3 +127,45 @@ def test_a_hard_pull_keeps_the_knot_and_its_tube(contact: str) -> None:
     assert set(res.knot_types) == {"3_1"}
     assert len(gaps) >= 5
     assert min(gaps) >= (0.3 if contact == "compliant" else 0.98)
+
+
+def test_a_knot_that_slips_off_a_hinged_end_says_so() -> None:
+    # Hinged ends and a pull far below what holds the frictionless 185 mm knot: the tail
+    # swings out through the loop, which the failure names as such (not a pass-through).
+    res = tie(open_trefoil(nodes=90, grip_length=0.0), pull_force=0.3, tighten_steps=20).run()
+    assert not res.converged
+    assert "knot type 0_1" in res.failure and "an end left the knot" in res.failure
+
+
+def test_a_pass_through_between_iterates_is_named() -> None:
+    # A closed trefoil and the same curve with one crossing switched by moving the upper
+    # strand's vertices straight down through the lower one: the path between the two
+    # meets the lower strand, and the change (to the unknot) is said to be a pass-through.
+    from tightknot.knots.scenes import closed_trefoil
+    from tightknot.loading.diagnose import topology_change
+    from tightknot.loading.tie import knot_type_of
+
+    scene = closed_trefoil(nodes=120)
+    x = scene.state.x
+    n = len(x)
+    best = None
+    for i in range(n):
+        p0, p1 = x[i, :2], x[(i + 1) % n, :2]
+        for j in range(i + 2, n - (1 if i == 0 else 0)):
+            q0, q1 = x[j, :2], x[(j + 1) % n, :2]
+            m = np.array([p1 - p0, q0 - q1]).T
+            if abs(np.linalg.det(m)) < 1e-14:
+                continue
+            s, t = np.linalg.solve(m, q0 - p0)
+            if 0 < s < 1 and 0 < t < 1:
+                dz = (x[i, 2] + s * (x[(i + 1) % n, 2] - x[i, 2])) - (
+                    x[j, 2] + t * (x[(j + 1) % n, 2] - x[j, 2]))
+                if best is None or abs(dz) > abs(best[2]):
+                    best = (i, j, dz)
+    i, j, dz = best
+    upper = [i, (i + 1) % n] if dz > 0 else [j, (j + 1) % n]
+    moved = x.copy()
+    moved[upper, 2] -= np.sign(dz) * 2.0 * abs(dz)
+    assert knot_type_of(scene, moved) == "0_1"
+    why = topology_change(scene, [x, moved], scene.model.edge_rest_length, knot_type_of)
+    assert "passed through itself" in why and "edges" in why

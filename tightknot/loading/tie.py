@@ -34,6 +34,7 @@ from tightknot.knots.scenes import (
     end_vertex,
     gauge,
 )
+from tightknot.loading.diagnose import topology_change
 from tightknot.loading.recentre import recentre_system
 from tightknot.rods.state import State
 from tightknot.solvers.continuation import (
@@ -91,10 +92,9 @@ def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | No
         if hook is not None:
             hook(phase, system, rec)
         if kt != scene.knot_type:
-            why = ("the rod passed through itself" if scene.closed else
-                   "the knot slipped off an end, or the rod passed through itself")
+            why = topology_change(scene, system.history or [], system.rest, knot_type)
             return (f"topology changed in phase {phase} at load t={rec.t:.4g}: knot type "
-                    f"{kt}, expected {scene.knot_type} ({why})")
+                    f"{kt}, expected {scene.knot_type}: {why}")
         # The next load step starts from the knot centred on its rod (open knots); the
         # last step's equilibrium is the phase's result and stays as it is.
         if rec.t < 1.0 - 1e-12:
@@ -104,9 +104,11 @@ def _checker(scene: KnotScene, phase: str, types: list[str], hook: StepHook | No
 
 
 def _attached(system: RodSystem, attach: Callable[[RodSystem], None] | None) -> RodSystem:
-    """``system`` handed to ``attach`` (a batch), at the start of its load path."""
+    """``system`` handed to ``attach`` (a batch), at the start of its load path, keeping the
+    iterates of each load step (a topology change is then told from them)."""
     if attach is not None:
         attach(system)
+    system.history = []
     system.set_load(0.0)
     return system
 
@@ -207,7 +209,8 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
     kt = knot_type(scene, system.state.x)
     types.append(kt)
     if kt != scene.knot_type:
-        return fail(f"relax: knot type {kt}, expected {scene.knot_type}", system, hold)
+        why = topology_change(scene, system.history or [], system.rest, knot_type)
+        return fail(f"relax: knot type {kt}, expected {scene.knot_type}: {why}", system, hold)
     recentre_system(scene, system)
     if scene.closed:
         bcs = gauge(scene, positions=system.state.x)

@@ -129,6 +129,9 @@ class RodSystem:
         #: than the check's floor: why a solve must stop (None while none did).
         self.accepted_count = 0
         self.violation: str | None = None
+        #: When a list: the positions [m] at the start of the load step and after every
+        #: accepted iterate since (what a topology check looks back on).
+        self.history: list[np.ndarray] | None = None
         self.set_load(0.0)
 
     def add_term(self, term: EnergyTerm) -> None:
@@ -160,6 +163,8 @@ class RodSystem:
         self._trial = None
         self.accepted_count = 0
         self.violation = None
+        if self.history is not None:
+            self.history = [st.x.copy()]
         # A new load step: contact blocks that stopped interacting leave the pattern.
         self.compact_pattern()
         if self.batch is not None:
@@ -339,6 +344,8 @@ class RodSystem:
         st.x, st.d1_ref, st.t_ref, st.m_ref = x.copy(), d1, tt, mref
         if self.model.twist:
             st.theta = theta.copy()
+        if self.history is not None:
+            self.history.append(st.x.copy())
         if self.proximity is not None:
             self.accepted_count += 1
             near = self.proximity.check(st.x, self.rest)
