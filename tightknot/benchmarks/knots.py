@@ -55,8 +55,8 @@ def warm_up(device: str = "cpu") -> float:
 
 def closed_case(nodes: int = 200, device: str = "cpu") -> dict:
     """The closed trefoil from loose start to equilibrium, with tie()'s default 20 initial
-    tightening steps (adaptive). The CLI's 40 give the same knot (measured at 200 vertices:
-    stretch equal to 1e-6, max kappa*D0 to 3e-5) in twice the Newton iterations."""
+    tightening steps (adaptive). The CLI's 40 give the same knot in twice the Newton
+    iterations."""
     scene = closed_trefoil(16.37, nodes=nodes, device=device)
     t0, c0 = time.perf_counter(), time.process_time()
     res = tie(scene).run()

@@ -21,11 +21,9 @@ tightknot; the scene travels as an ``.npz``): PyElastica in this interpreter (``
 tightknot[peers]``), dismech-newton in its own environment (``--dismech-python``). A peer
 that is missing or fails gives a row with an ``error`` string; the benchmark still succeeds.
 
-X defaults to 0.120 m: tightknot's tightening (300 vertices) ends at 0.127 m with Lambda_OC
-11.5; a pull back from there measured Lambda_OC 12.0 at 0.1208 m and lost the knot at
-0.1188 m (knot type 0_1; 20 load steps), so X stays just above that. At X this benchmark
-measures Lambda_OC 11.9 (101 vertices): a tight knot, near the tightest ideal open trefoil
-(12.4), at the low end of the issue's suggested 12 to 15.
+X defaults to 0.120 m: just above the end distance at which a pull of the tightened knot
+loses it, so a tight knot near the tightest ideal open trefoil (Lambda_OC 12.4)
+(docs/design_notes.md, peers).
 """
 
 from __future__ import annotations

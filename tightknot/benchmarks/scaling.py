@@ -8,13 +8,11 @@ number of contact pairs, grows linearly with N.
 Why the helix radius is one diameter (``RADIUS``). The contact graph of the coil is a grid
 wrapped on a cylinder: W vertices around a turn, L = N / W turns along it. A sparse direct
 solve of such a grid costs about N min(W, L)^2 (the separators are the shorter side), so
-it is linear in N only once L >= W. Until 2026-12-01 the radius was 3 D0 (W = 75): the
-1e3-vertex coil had 13 turns (L < W, cheap separators across the turns) and the 1e5 one
-1333, so t(1e5)/t(1e3) mixed the two regimes and measured 228 per iteration, the solve
-alone 251 (fill of the LU 8.1 times the matrix at 1e3, 11.6 at 1e5). At 1 D0 (W = 25) the
-1e3 coil already has 39 turns and both sizes are in the long regime. ``--helix-radius 3``
-runs the old scene. One Newton iteration is split into its
-parts, each timed on its own (median of repeats) at the start state:
+it is linear in N only once L >= W. At 1 D0 (W = 25) the 1e3-vertex coil already has 39
+turns, so both ends of the size range are in the long regime (a wider coil mixes the two
+regimes; ``--helix-radius 3`` runs the earlier scene, docs/design_notes.md). One Newton
+iteration is split into its parts, each timed on its own (median of repeats) at the start
+state:
 
 - elastic: Warp evaluation of the DER energy, gradient and Hessian (into the fixed pattern);
 - contact: detection (BVH, candidate pairs) and the pair kernel, plus the conversion of
@@ -56,12 +54,10 @@ EDGE = 0.25  # the contact layer resolves contact with edges below 0.3 D0 (conta
 PITCH = 0.99  # turns overlap by ~1 % of D0: every turn is in contact with the next
 #: Time step of the full solve [s] (see full_solve). Bending waves of a turn scale with the
 #: square of its length, so a tighter coil takes a shorter step: 1e-3 s in the 3 D0 coil,
-#: 3e-4 s in this one (measured at 1e3 vertices: 14 Newton iterations, the old scene 15;
-#: 1e-3 s took 96 here).
+#: 3e-4 s in this one.
 STEP_DT = 3e-4
-#: Largest size of the full solve by default, and its Newton budget. At 1e4 vertices the
-#: step converges in 28 iterations (24.8 s, measured); the old 3 D0 coil took 100 there
-#: without converging (1611 s on the loaded 2 cores).
+#: Largest size of the full solve by default, and its Newton budget (the step converges
+#: well within it at 1e4 vertices).
 SOLVE_MAX = 10000
 SOLVE_ITERATIONS = 30
 #: The issue's targets.
@@ -161,8 +157,8 @@ def full_solve(n: int, dt: float = STEP_DT, residual_tol: float = 1e-6,
 
     Why a time step and not the static equilibrium: a coil of a straight rod with pressed
     turns between clamps is frustrated (its turns can separate only by rearranging the
-    whole coil), and the static Newton solve from it did not converge in 60 iterations at
-    1e3 vertices (measured); the time step is the well-posed solve a dynamic simulation
+    whole coil), and the static Newton solve from it does not converge; the time step is
+    the well-posed solve a dynamic simulation
     makes at every step. The tolerance is relative to the rod's section, not its length:
     the system's own scale EI/L^2 shrinks as 1/N^2 and would ask for forces below
     round-off at 1e5 vertices.

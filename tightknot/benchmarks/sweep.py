@@ -24,15 +24,14 @@ DEFAULT_LEVELS = 20
 DEFAULT_NODES = 300
 DEFAULT_LENGTH = 0.185
 #: Loosest and tightest Lambda_OC: the study's level of the 185 mm knot, and a knot as tight
-#: as the study's 125 mm one (10.1) that this length still reaches by pulling (measured
-#: here: 10.2 at 5.7 N).
+#: as the study's 125 mm one (10.1) that this length still reaches by pulling.
 DEFAULT_LOOSEST, DEFAULT_TIGHTEST = 15.0, 10.25
 TARGET_WALL_TIME_S = 30.0
 
 
 def _warm_up() -> float:
     """Load Warp's kernels, numba's cache and the contact tables once (what every process
-    pays first; measured 5 to 10 s here) and return its time [s]."""
+    pays first) and return its time [s]."""
     from tightknot.sweep.execute import run_case
 
     t0 = time.perf_counter()

@@ -44,8 +44,7 @@ ACCEPT = {"kappa_rms": 0.05, "closed_measure_rel": 0.005, "open_measure_abs": 0.
 #: Full study and the quick one: per knot, the vertex counts of the full model, the other
 #: levels and the vertex counts they run at. The closed trefoil has no rigid-tube run: its
 #: L0/D0 16.37 is below the ideal 16.3715, so a rigid tube can only be tied by squeezing
-#: the rod along its axis against a contact 1000 times stiffer, and the tie crawls
-#: (measured: 508 s at 40 vertices against 6 s compliant, L/D 0.2 off).
+#: the rod along its axis against a contact 1000 times stiffer, and the tie crawls.
 FULL = {
     "closed_trefoil": {"nodes": (50, 100, 200, 400, 800), "levels": ("twist_flipped",),
                        "level_nodes": (50, 100, 200)},

@@ -78,9 +78,8 @@ from .scenes._common import MESH_LEVELS, finite, relative
 
 DEFAULT_MESH: str = "medium"
 """FEM mesh of the comparison: the mesh the shipped law was calibrated on. The coarse
-mesh differs from it by up to 19 % in the indent force (approach 0.012 D0, patch below
-two elements) and 10 % in the wrap's mid line load (T = 0.25 E D0^2): as large as the
-targets, so it cannot referee them (measured; see docs/fem_crosscheck.md)."""
+mesh differs from it by as much as the targets, so it cannot referee them
+(docs/fem_crosscheck.md)."""
 
 APPROACH_LIMIT: float = 0.25
 """Largest approach over D0 at which the targets apply (the issue's range)."""

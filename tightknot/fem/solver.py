@@ -4,8 +4,7 @@ Displacement control: every load parameter moves the rigid surfaces (all Dirichl
 conditions are homogeneous symmetry or end conditions), Newton's method solves for the
 displacements, and a failed increment is cut back (halved) from the last checkpoint.
 The sparse symmetric system is factorised by SuperLU with diagonal pivoting off and the
-symmetric mode on (2 to 3 times faster than the default on 3D hexahedral matrices, as
-measured by a scout on this project's meshes).
+symmetric mode on (faster than the default on 3D hexahedral matrices).
 """
 
 from __future__ import annotations

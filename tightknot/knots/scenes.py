@@ -435,13 +435,10 @@ def open_figure_eight(
     axis, built, held and pulled like :func:`open_trefoil`. Default L0 = 0.30 m (35 D0):
     the figure-eight's core is ~1.3 times the trefoil's (ideal closed 21.04 D0 against
     16.37 D0), and its tails must stay long enough while the rest length shrinks
-    (measured at 100 vertices: from 0.25 m the knot slips off an end near the end of the
-    tightening, knot type 0_1; 0.28 and 0.30 m hold, Lambda_OC ~20 at 2 N)."""
+    (docs/design_notes.md, scenes)."""
     # Tail corners rounded with std 2 knot-size units within 5 units of them: the
     # trefoil's 0.5 leaves a corner whose bend, not the knot, sets the start's size, and
-    # std 2 over the whole curve pulls the strands together (start length over the largest
-    # tube diameter, measured: 131 D with 0.5, 95 with 2 everywhere, 72 with 2 near the
-    # corners; the knot type stays 4_1).
+    # std 2 over the whole curve pulls the strands together.
     return _open_knot("open_figure_eight", "4_1", curves.open_figure_eight, rest_length,
                       diameter, nodes, material, law, twist, contact, device, tail_fraction,
                       clearance, corner_std=2.0, grip_length=grip_length,

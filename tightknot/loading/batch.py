@@ -17,21 +17,13 @@ round-off (the joint evaluation sums in another order; the Newton systems are so
 banded Cholesky factorization, :mod:`tightknot.solvers.banded`). Where a path is close
 to a fork, round-off can still lead a rod to another equilibrium than its tie's, e.g. the
 same closed knot shifted along its rod; ``tightknot bench batch`` reports each case's
-difference (64 trefoils of 100 vertices, L0/D0 17 to 20: none over 1e-10 D0 in
-positions; round-off changed the Newton iteration count of 19 of the 64 cases, by up to
-43 of 326, with 14 816 iterations in all against 14 794 one by one).
+difference from its own tie.
 
-What it buys on the CPU (``tightknot bench batch``, those 64 trefoils, 2 cores shared
-with other jobs): 1.9x to 2.5x in four runs over tying them one after another (3.8 to 5.2
-against 9.5 to 11.5 ms per rod and Newton iteration; the target was 5x). The rounds are
-those of the slowest rod (401); the launches, BVH builds and Python steps of an evaluation
-are paid once per round, so evaluation and step bounds cost 1.3 to 1.9 ms per
-rod-iteration. What batching cannot share stays per rod: the factorizations of each
-rod's 400-dof Newton system (1.8 to 2.4 ms per rod-iteration: 1.8 factorizations, more
-than half of them of indefinite matrices, which need LU; about what SuperLU costs the
-one-rod solver), the rods' own Python steps (0.6 to 0.9 ms) and the knot-type checks
-(0.1 ms). On a GPU the evaluation's share is where the gain lies; the linear solves would
-need a batched solver there too.
+The launches, BVH builds and Python steps of an evaluation are paid once per round for all
+rods; what batching cannot share stays per rod: the factorizations of each rod's Newton
+system, the rods' own Python steps and the knot-type checks. On a GPU the evaluation's
+share is where the gain lies; the linear solves would need a batched solver there too
+(docs/design_notes.md, batched rods: what it buys on the CPU).
 """
 
 from __future__ import annotations

@@ -33,9 +33,7 @@ def recentre_open_knot(scene: KnotScene, x: np.ndarray, rest: np.ndarray,
     A frictionless knot on a uniform rod can sit anywhere along it: moving the rod's
     material through the knot changes no energy while the tails are straight, so the
     knot's position is a zero mode that Newton steps drift along with whatever asymmetry
-    round-off brings (measured: a 1e-9 D0 perturbation of the start left the loose 185 mm
-    knot 2 to 6 D0 off centre after the relaxation, and 2 of 4 such runs at 150 vertices,
-    3 of 3 at 300, slid off the shorter tail when loosened to Lambda_OC 15). The study's
+    round-off brings (docs/design_notes.md, re-centring). The study's
     knots sit mid-rod, so tie() puts them there. The knot's extent is the span of vertices
     in contact (within ``tol`` of the nominal diameter); the material moves by the whole
     number of edges k nearest to the rest arc between the knot's centre and the rod's

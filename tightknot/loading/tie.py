@@ -193,7 +193,7 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
     shrink = 1.0 / scene.start_length_ratio
     # The start curve is not an equilibrium: relax it first (an open knot's end sliding
     # under a small tension, so the loose loops do not swing freely), with a budget for the
-    # long, floppy path of a loose knot (measured: 150 iterations for 150 vertices).
+    # long, floppy path of a loose knot.
     bcs = gauge(scene)
     if not scene.closed:
         bcs.force(0, last, lambda t: hold * axis)
@@ -217,7 +217,7 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
     else:
         # The end then follows the shrink (end-to-end distance scaled with the rest
         # length): with a freely sliding end the tail slides out of the shrinking loop and
-        # the knot slips off the rod (measured: knot type 0_1 at 55 % of the path).
+        # the knot slips off the rod.
         bcs = gauge(scene, positions=system.state.x, sliding_end=False)
         span = float(system.state.x[last] @ axis)
         bcs.pin(0, last, translation=lambda t: (shrink - 1.0) * t * span * axis)

@@ -1,9 +1,8 @@
 """Warp kernels of the elastic energies (stretch, bend, twist) and of the reference frames.
 
-One module, so it compiles once. Float64 throughout (tight contact needs it: float32
-gradients were measured 4 % off). Kernels follow the mujoco_warp layout: parameters grouped
-as Model / Data in / Out, each kernel launched by a thin function in
-:mod:`tightknot.rods.elastic`.
+One module, so it compiles once. Float64 throughout (tight contact needs it). Kernels follow
+the mujoco_warp layout: parameters grouped as Model / Data in / Out, each kernel launched by
+a thin function in :mod:`tightknot.rods.elastic`.
 
 Energies (Bergou, Wardetzky, Robinson, Audoly, Grinspun 2008, "Discrete elastic rods";
 Bergou, Audoly, Vouga, Wardetzky, Grinspun 2010, "Discrete viscous threads"):

@@ -1,12 +1,10 @@
 """Reused device arrays and recorded kernel launches for the per-iteration hot path.
 
-A Newton iteration of a small rod makes about 19 Warp launches and used to create about 25
-device arrays from NumPy. Each costs Python time, not arithmetic: measured with warp-lang
-1.19 on the CPU, ``wp.array(numpy)`` takes 15.5 us, ``wp.zeros`` 6.7 us, and a launch of a
-6-argument kernel over 99 edges 15.7 us. A copy into an existing array's NumPy view takes
-0.26 us, and a replayed ``wp.Launch`` 5.2 us. On the 101-vertex open trefoil that was about
-a fifth of the time of an iteration (cProfile; ``tightknot bench peers``). These helpers
-keep the same arrays and launches alive from one evaluation to the next. The numbers
+A Newton iteration of a small rod makes about 19 Warp launches and needs about 25 device
+arrays. Creating an array from NumPy or packing a launch's arguments costs Python time,
+not arithmetic, many times what a copy into an existing array or a replayed ``wp.Launch``
+costs (docs/design_notes.md, staging). These helpers keep the same arrays and launches
+alive from one evaluation to the next. The numbers
 reaching the kernels are the same, so the results are bit for bit those of fresh arrays.
 
 Aliasing rule: a staged array holds the data of its last :meth:`Staging.put`. Callers pass

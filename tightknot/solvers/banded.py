@@ -2,12 +2,10 @@
 
 One closed 100-vertex knot has about 400 free dofs; its contact couples strands far apart
 along the rod, so SuperLU (:func:`tightknot.solvers.linear.factorize`) fills in a third of
-the dense matrix and needs 1.2 to 1.5 ms per factorization, most of it fixed overhead of
-the supernodal code on so small a matrix (measured on a tied 100-vertex trefoil, 393 dofs,
-13 395 entries). Reordered by reverse Cuthill-McKee (Cuthill & McKee 1969; George & Liu
-1981, sec. 4.3) the same matrix has a half-bandwidth of about 80, and LAPACK's banded
-Cholesky ``dpbtrf`` factors it in 0.25 ms (0.35 ms with the copy into band storage and the
-solve): the linear algebra of a Newton iteration is then a fifth of SuperLU's.
+the dense matrix, and on so small a matrix the supernodal code's fixed overhead dominates.
+Reordered by reverse Cuthill-McKee (Cuthill & McKee 1969; George & Liu 1981, sec. 4.3) the
+same matrix has a half-bandwidth of about 80, and LAPACK's banded Cholesky ``dpbtrf``
+factors it several times faster (docs/design_notes.md, batched rods).
 
 The matrix is equilibrated symmetrically first (``S A S``, ``S = |diag A|^-1/2``), as
 :class:`tightknot.solvers.linear.Factorization` does. A matrix that is not positive
@@ -19,10 +17,8 @@ entries to band storage depend only on the sparsity pattern, so they are built o
 pattern (:class:`BandPlan`) and reused while the contact set stays within it.
 
 LAPACK runs in OpenBLAS, which by default spreads every call over all cores; on a band
-of 80 that is pure synchronisation (measured on the 2-core machine, shared: 32 ms per
-factorization instead of 0.45 ms), so the batch runs with one BLAS thread
-(:func:`single_blas_thread`). The one-rod solver is not affected (SuperLU on 400 dofs:
-four 100-vertex ties took 7.24 s with the default threads, 7.23 s with one).
+of 80 that is pure synchronisation, so the batch runs with one BLAS thread
+(:func:`single_blas_thread`); the one-rod solver (SuperLU) is not affected by the setting.
 """
 
 from __future__ import annotations
@@ -141,8 +137,7 @@ class BandedCholesky:
 def banded_lu_solve(plan: BandPlan, data: np.ndarray, b: np.ndarray) -> np.ndarray | None:
     """Solve A x = b for the matrix with entries ``data`` on ``plan``'s pattern by banded
     LU with partial pivoting (LAPACK ``dgbsv``; for an indefinite matrix, where the
-    Cholesky factorization fails: 0.53 ms against SuperLU's 1.5 ms at 393 dofs and a
-    half-bandwidth of 81); None when A is exactly singular."""
+    Cholesky factorization fails); None when A is exactly singular."""
     s, scaled = _equilibration(plan, data)
     n, bw = plan.n, plan.bandwidth
     # dgbsv's band storage: kl extra rows on top for the fill of the pivoting, then

@@ -85,10 +85,9 @@ def inertia_tolerance(system: RodSystem, dt: float, options: NewtonOptions) -> N
 
     The inertia force ``m/dt^2 (q - q_hat)`` is computed from absolute coordinates, each
     known to eps |q|, so it carries a round-off of ``m/dt^2 eps |q|``; in the residual's
-    units (forces over EI/L^2) that is a floor no Newton iterate can go below (measured on
-    the tied closed trefoil at dt = 1e-6 s: 6e-8 against this estimate 2.5e-7, while the
-    default tolerance is 1e-8). Four times the estimate is asked; above 1e-5 s the floor is
-    below 1e-8 for the study's rod and nothing changes.
+    units (forces over EI/L^2) that is a floor no Newton iterate can go below. Four times
+    the estimate is asked; above 1e-5 s the floor is below 1e-8 for the study's rod and
+    nothing changes (docs/design_notes.md, implicit dynamics).
     """
     free = system.pattern.free_dofs
     if free.size == 0:

@@ -17,11 +17,9 @@ class Factorization:
 
     The matrix is first equilibrated symmetrically, ``S A S`` with ``S = |diag A|^-1/2``:
     positions and twist angles have stiffnesses many decades apart (EA/l against GJ/l),
-    and SuperLU without pivoting lost digits (measured on a 1e5-vertex helix: relative
-    residual 5e-5 with ``diag_pivot_thresh=0``; 1e-9 with the threshold 0.1 used here, at
-    the same speed). A banded matrix (an open rod without contact) keeps its natural order,
-    which is already optimal (0.38 s against 0.57 s for minimum degree at 1e5 vertices);
-    otherwise the ordering is minimum degree on A^T + A.
+    and SuperLU without pivoting loses digits on them. A banded matrix (an open rod
+    without contact) keeps its natural order, which is already optimal; otherwise the
+    ordering is minimum degree on A^T + A (docs/design_notes.md, linear algebra).
     """
 
     #: Largest |row - col| for which the natural order is kept.
@@ -39,9 +37,8 @@ class Factorization:
                            shape=a.shape)
         bandwidth = int(np.abs(rows - cols).max()) if a.nnz else 0
         spec = "NATURAL" if bandwidth <= self.BANDED_LIMIT else "MMD_AT_PLUS_A"
-        # Prefer diagonal pivots with a symmetric pattern (the FEM scout measured this 2-3x
-        # faster than the defaults on symmetric matrices), but pivot when a diagonal entry is
-        # below 0.1 of its column's largest.
+        # Diagonal pivots with a symmetric pattern are faster on symmetric matrices; pivot
+        # when a diagonal entry is below 0.1 of its column's largest.
         self._lu = spla.splu(sa, permc_spec=spec, diag_pivot_thresh=0.1,
                              options=dict(SymmetricMode=True))
 

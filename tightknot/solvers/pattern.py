@@ -9,12 +9,12 @@ With contact the pattern is the elastic one plus 3 x 3 vertex blocks, kept from 
 iteration to the next (:class:`ContactPattern`).
 
 Contact couples the positions of vertices that are far apart along the rod, so its entries
-change with the contact set. Sending them as COO triplets (144 per edge pair) and letting
-scipy sort and sum them cost 20 ms per iteration on a tight 300-vertex trefoil, 40 times
-the elastic assembly. Here the pattern is a union of vertex blocks that only grows while
-the contact set moves within it: the contact kernel adds each block straight into the CSC
-data array through a sorted block table (binary search in the kernel), and the pattern is
-rebuilt only when a block is missing (a new contact), which is rare within a load step.
+change with the contact set. Sending them as COO triplets (144 per edge pair) for scipy
+to sort and sum would cost many times the elastic assembly. Here the pattern is a union of
+vertex blocks that only grows while the contact set moves within it: the contact kernel
+adds each block straight into the CSC data array through a sorted block table (binary
+search in the kernel), and the pattern is rebuilt only when a block is missing (a new
+contact), which is rare within a load step.
 
 A block (vr, vc) is the 3 x 3 coupling of the positions of vertex vr (rows) and vc
 (columns), restricted to the free components; blocks whose vertices are fully fixed stay in
