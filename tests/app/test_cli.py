@@ -285,3 +285,22 @@ def test_view_print_only_prints_the_command(closed_run: Path, capsys) -> None:
     assert main(["view", str(rrd), "--print-only"]) == 0
     line = capsys.readouterr().out.strip()
     assert line.endswith(str(rrd)) and "rerun" in line
+
+
+def test_analyze_of_a_tied_open_knot_gives_its_lambda_oc(tmp_path) -> None:
+    # One Lambda_OC: the command the centerline.csv header gives (sections thinned by their
+    # stretch) measures the file as the tie measured its state (10.115 against 10.331 when
+    # analyze took nominal radii).
+    out = tmp_path / "open"
+    assert main(["tie", "open", "--nodes", "90", "--force", "3", "--tighten-steps", "20",
+                 "--quiet", "--out", str(out)]) == 0
+    data = _summary(out)
+    header = (out / "centerline.csv").read_text().splitlines()[1]
+    args = header.split("tightknot ", 1)[1].split()
+    assert args[0] == "analyze" and "--radii" in args
+    rep_json = tmp_path / "a.json"
+    assert main([args[0], str(out / args[1]), *args[2:], "--json", str(rep_json),
+                 "--quiet"]) == 0
+    rep = json.loads(rep_json.read_text())
+    # Same points (repr floats), same radii up to the round-off of the rest lengths.
+    assert rep["Lambda_OC"] == pytest.approx(data["lambda_oc"], abs=1e-9)

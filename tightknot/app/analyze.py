@@ -80,6 +80,11 @@ def register(subparsers: Any) -> None:
                    help="rest length L0 in --units (default: the measured length, stretch 1)")
     p.add_argument("--poisson", type=float, default=0.5, metavar="NU",
                    help="Poisson ratio of D = D0 [1 - nu (L - L0)/L0] (default 0.5)")
+    p.add_argument("--radii", choices=("nominal", "stretch"), default="nominal",
+                   help="radii of the contact test: nominal D0/2 (measured data; default), "
+                        "or stretch: each section thinned by its edge's stretch over a rod "
+                        "of equal rest edges of total --rest-length (a simulation's own "
+                        "measure: a tie's centerline.csv header asks for it)")
     p.add_argument("--json", default=None, metavar="OUT",
                    help="write every measurement to OUT as JSON (atomically; SI units)")
     p.add_argument("--figures", default=None, metavar="DIR",
@@ -288,10 +293,13 @@ def run_analyze(args: argparse.Namespace) -> int:
     except CenterlineError as err:
         return _fail(str(err))  # already "<file>:<line>: <what>"
     rest_length = None if args.rest_length is None else args.rest_length * factor
+    if args.radii == "stretch" and rest_length is None:
+        return _fail("--radii stretch needs --rest-length (the rod's length at rest)")
     try:
         report = analyze_centerline(points, args.diameter * factor, closed,
                                     smooth_n_gauss=args.smooth, rest_length=rest_length,
-                                    poisson=args.poisson)
+                                    poisson=args.poisson,
+                                    radii="stretch" if args.radii == "stretch" else None)
     except ValueError as err:
         # Geometry the measures cannot handle (a polygon folding back on itself, ...): the
         # whole curve is at fault, so the message names the file without a line.

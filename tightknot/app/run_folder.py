@@ -142,7 +142,7 @@ def write_centerline(path: Path, x: np.ndarray, scene_name: str, diameter: float
     header = (f"final centerline [m] of {scene_name}, D0 = {diameter!r} m, L0 = "
               f"{rest_length!r} m\n"
               f"measure it: tightknot analyze {path.name} --diameter {diameter!r} "
-              f"--rest-length {rest_length!r} {kind}\n"
+              f"--rest-length {rest_length!r} --radii stretch {kind}\n"
               "x_m,y_m,z_m")
     write_centerline_csv(path, x, header=header)
 

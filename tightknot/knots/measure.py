@@ -19,6 +19,7 @@ from tightknot.knots.closed_measures import closed_knot_profile
 from tightknot.knots.contact_map import contact_pairs, double_contact_fraction
 from tightknot.knots.curvature import bergou_curvature, find_spikes
 from tightknot.knots.curves import exclusion_arc_length, min_nonlocal_distance, resample_uniform
+from tightknot.knots.open_measures import contact_gaps
 from tightknot.knots.smoothing import study_smooth, study_window
 from tightknot.knots.topology import (
     TopologyError,
@@ -62,7 +63,10 @@ def analyze_centerline(
     rest_length: L0 [m]; default the measured length L (then stretch = 1, D = D0).
     poisson: nu of the reduced diameter D = D0 [1 - nu (L - L0)/L0].
     radii: per-vertex deformed radii [m] for the contact map (only with the raw polygon,
-        whose vertices they belong to); default D0/2 (measured data).
+        whose vertices they belong to); "stretch": each section thinned by its local
+        stretch, r0 lambda^-nu (lambda: an edge's length over L0 / edges, a rod of equal
+        rest edges, as the package's scenes; the vertex takes its edges' mean), which is
+        how a tie's summary measures its own centerline; default D0/2 (measured data).
     contact_tol: relative tolerance of the contact test (distance <= (a_i + a_j)(1 + tol)).
     spike_threshold: kappa*D0 above which a run of vertices is a curvature spike.
     double_contact_tol: relative tolerance of the double-contact check (ideal knots).
@@ -83,7 +87,7 @@ def analyze_centerline(
         out.update(smoothed=True, smooth_n_gauss=float(smooth_n_gauss), resample_step=h,
                    smooth_window_points=study_window(p.shape[0], smooth_n_gauss),
                    length_before_smoothing=raw_length)
-        if radii is not None and np.ndim(radii) > 0:
+        if radii is not None and not isinstance(radii, str) and np.ndim(radii) > 0:
             raise ValueError("per-vertex radii cannot be combined with smoothing (resampled)")
     n = p.shape[0]
     length = total_length(p, closed)
@@ -113,7 +117,14 @@ def analyze_centerline(
     dmin, sa, sb = min_nonlocal_distance(p, closed, exclusion_arc_length(d0))
     out.update(min_nonlocal_distance_over_D0=dmin / d0 if np.isfinite(dmin) else None,
                min_nonlocal_pair_S=[sa, sb] if np.isfinite(dmin) else None)
-    a = 0.5 * d0 if radii is None else np.asarray(radii, dtype=np.float64)
+    if isinstance(radii, str):
+        if radii != "stretch":
+            raise ValueError(f"radii must be per-vertex values or 'stretch', got {radii!r}")
+        if smooth_n_gauss is not None:
+            raise ValueError("radii='stretch' cannot be combined with smoothing (resampled)")
+        a = stretch_radii(p, d0, l0, poisson, closed)
+    else:
+        a = 0.5 * d0 if radii is None else np.asarray(radii, dtype=np.float64)
     ci, cj = contact_pairs(p, closed, a, tol=contact_tol)
     out["contact_tol"] = contact_tol
     out["spike_threshold_kappa_D0"] = spike_threshold
@@ -138,7 +149,8 @@ def analyze_centerline(
         )
         spikes = find_spikes(kappa[order], prof["s"], spike_threshold, closed=True)
     else:
-        om = open_knot_measures_dict(ci, S, d0)
+        gaps = contact_gaps(p, False, a, tol=contact_tol)
+        om = open_knot_measures_dict(gaps, S, d0)
         s_open = om.pop("s")
         out.update(om)
         out.update(s=_list(s_open), contact_s=_list(s_open[ci]), contact_sigma=_list(s_open[cj]))
@@ -148,11 +160,33 @@ def analyze_centerline(
     return out
 
 
-def open_knot_measures_dict(ci: np.ndarray, S: np.ndarray, d0: float) -> dict[str, Any]:
-    """Open-knot entries of :func:`analyze_centerline` (NaN written as None for JSON)."""
+def stretch_radii(points: np.ndarray, diameter: float, rest_length: float, poisson: float,
+                  closed: bool) -> np.ndarray:
+    """Per-vertex radii [m] of a rod of equal rest edges (length ``rest_length`` [m]) whose
+    sections thin with their edges' stretch: r0 lambda^-nu per edge (the incompressible
+    section of :func:`tightknot.knots.scenes.vertex_radii`), averaged onto the vertices."""
+    e = np.linalg.norm((np.roll(points, -1, axis=0) - points) if closed
+                       else np.diff(points, axis=0), axis=1)
+    lam = e / (rest_length / e.size)
+    r_e = 0.5 * diameter * lam ** (-poisson)
+    n = points.shape[0]
+    r_v = np.zeros(n)
+    cnt = np.zeros(n)
+    first = np.arange(e.size)
+    second = (first + 1) % n
+    np.add.at(r_v, first, r_e)
+    np.add.at(r_v, second, r_e)
+    np.add.at(cnt, first, 1.0)
+    np.add.at(cnt, second, 1.0)
+    return r_v / cnt
+
+
+def open_knot_measures_dict(gaps: np.ndarray, S: np.ndarray, d0: float) -> dict[str, Any]:
+    """Open-knot entries of :func:`analyze_centerline` from the vertex contact gaps
+    (:func:`tightknot.knots.open_measures.contact_gaps`; NaN written as None for JSON)."""
     from tightknot.knots.open_measures import open_knot_measures
 
-    om = open_knot_measures(ci, S, d0)
+    om = open_knot_measures(gaps, S, d0)
 
     def clean(v: float) -> float | None:
         return None if np.isnan(v) else float(v)
