@@ -21,6 +21,7 @@ its first (only) compile.
 import functools
 import inspect
 import types
+from collections.abc import Callable
 from enum import IntEnum
 from typing import NamedTuple
 
@@ -134,9 +135,14 @@ def closest_approach(geo: PairGeometry, law: PairLaw, gauss_xi: wp.array(dtype=w
     return s_min, local_hit
 
 
-def _kernel_without(template, unused: set[str], key: str) -> wp.Kernel:
-    """A kernel of the function ``template`` without its parameters ``unused`` (which only
-    statically dead branches of the template read), in the contact kernels' module."""
+def _kernel_without(template: Callable, unused: set[str], key: str) -> wp.Kernel:
+    """A kernel of the function ``template`` without its parameters ``unused``, in the
+    contact kernels' module.
+
+    Warp takes a kernel's parameters from its function's signature and annotations and its
+    body from the source: a copy of the function (same code and closure, so the same
+    ``wp.static`` values) with those two trimmed is the template minus the parameters that
+    only its statically dead branches read."""
     sig = inspect.signature(template)
     params = [p for name, p in sig.parameters.items() if name not in unused]
     func = types.FunctionType(template.__code__, template.__globals__, key,

@@ -69,8 +69,7 @@ class BatchBroadPhase(BroadPhase):
             self._reuse = self._store = False
 
     def arcs_of(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
-        # The base class loops over the rods (64 rods: about 1 ms, each time the rest
-        # lengths change; BroadPhase.arcs reuses the result while they do not).
+        # The base class loops over the rods in Python, each time the rest lengths change.
         # Rods of one edge count: one cumulative sum along each row of a (rods, edges)
         # view, the same additions in the same order as the loop.
         m = self.model
