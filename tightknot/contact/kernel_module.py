@@ -4,7 +4,9 @@ Warp compiles a module as one unit and recompiles all of it when a kernel is add
 broad phase, the step bound and the pair kernel's variants (each defined beside its
 launcher) share one module, filled at import. Loops are not unrolled (``max_unroll`` 1):
 unrolling the pair kernel's 4 x 4 vertex blocks makes the module slow to compile; no
-backward (adjoint) code is generated: the contact layer writes its derivatives by hand.
+backward (adjoint) code is generated: the contact layer writes its derivatives by hand (and
+the pair kernel's accumulating wp.funcs take ``wp.ref`` parameters, which Warp allows only
+without it).
 """
 
 from __future__ import annotations
