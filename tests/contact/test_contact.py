@@ -190,7 +190,7 @@ def test_step_bound_prevents_passing_through() -> None:
     x = m.vertex_initial_position
     dx = np.zeros_like(x)
     dx[m.rods[1].vertex_slice, 2] = -3.0 * D
-    alpha = cl.max_step(x, dx)
+    alpha = cl.max_step(x, dx, m.edge_rest_length)
     # The bound keeps the segments at least the hard limit apart: at alpha the gap is
     # 1.2 D - 3 D alpha >= 0.1 D, i.e. alpha <= 1.1/3; and it is not needlessly small.
     assert 0.0 < alpha <= 1.1 / 3 + 1e-12
@@ -198,7 +198,7 @@ def test_step_bound_prevents_passing_through() -> None:
     dist, _, _ = cl.min_distance(x + alpha * dx)
     assert dist >= 0.1 * D * (1 - 1e-9)
     # A step that moves away is not limited.
-    assert cl.max_step(x, -dx) == 1.0
+    assert cl.max_step(x, -dx, m.edge_rest_length) == 1.0
 
 
 def test_start_that_intersects_itself_is_refused_with_arc_lengths() -> None:

@@ -98,7 +98,7 @@ def test_window_spreads_the_thinning():
     lam = layer.section_stretch(x, m.edge_rest_length)
     own = ContactLayer(m).section_stretch(x, m.edge_rest_length)
     assert own[18] == pytest.approx(1.24)
-    assert layer._smooth.window_edges[0] == 12  # 1 D0 at 12 edges per D0
+    assert layer.section_radius.window_edges[0] == 12  # 1 D0 at 12 edges per D0
     assert lam[18] == pytest.approx(1.0 + 0.24 / 25)  # a window of 25 edges
     assert lam[:36].sum() == pytest.approx(own[:36].sum(), rel=0.02)  # cut at the ends
 

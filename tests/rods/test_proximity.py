@@ -96,7 +96,7 @@ class _Apart(EnergyTerm):
     name = "apart"
     keeps_apart = True
 
-    def max_step(self, x, dx):
+    def max_step(self, x, dx, rest):
         # A step bound that does not see the pair: steps of at most 0.02 D.
         return min(1.0, 0.02 * D / max(float(np.abs(dx).max()), 1e-300))
 

@@ -110,7 +110,7 @@ def test_a_contact_layer_called_again_equals_a_fresh_one() -> None:
         other = x.copy()
         other[n:, 2] -= shift
         layer.evaluate(other, model.edge_rest_length)
-        layer.max_step(other, 0.01 * D * np.ones_like(other))
+        layer.max_step(other, 0.01 * D * np.ones_like(other), model.edge_rest_length)
     again = layer.evaluate(x, model.edge_rest_length)
     assert fresh[0] == again[0] and fresh[0] > 0.0
     np.testing.assert_array_equal(fresh[1], again[1])

@@ -17,7 +17,7 @@ For the pair (``w = delta/2``) the energies are the integrals of the force over 
 ``e_line(delta) = 2 k_line E D^2 (delta/2D)^(p+1)/(p+1)`` [J/m] and likewise
 ``e_point(delta) = 2 k_point E D^3 (delta/2D)^(q+1)/(q+1)`` [J].
 
-Realisation on the rods (:mod:`tightknot.contact.kernels`): the contact energy is a
+Realisation on the rods (:mod:`tightknot.contact.pair_kernel`): the contact energy is a
 double integral over both centerlines of a pair kernel psi(rho) of the distance rho between
 two points, evaluated by Gauss quadrature on the edges, with R = r_i + r_j (stretched radii)
 and delta = R - d. The kernels are the exact inverses of the laws, so that straight strands

@@ -10,7 +10,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import warp as wp
 
 from tightknot.contact.layer import ContactLayer
 
@@ -80,7 +79,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
     m = layer.model
     law = layer.law
     n = m.vertex_count
-    rest = layer.rest if rest is None else np.asarray(rest, dtype=np.float64)
+    rest = layer.last_rest if rest is None else np.asarray(rest, dtype=np.float64)
     ev = m.edge_vertex
     e = x[ev[:, 1]] - x[ev[:, 0]]
     le = np.linalg.norm(e, axis=1)
@@ -89,11 +88,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
     nu = np.array([0.0 if law.rigid else m.rods[r].material.poisson_ratio for r in m.edge_rod])
     radius_e = m.edge_radius * stretch_e ** (-nu)
     d0 = 2.0 * m.edge_radius
-    wx = wp.array(np.ascontiguousarray(x), dtype=wp.vec3d, device=layer.device)
-    arcs, rod_len = layer._arcs(rest)
-    pairs = layer._candidates(wx, layer._zero_dx, layer._margin, arcs, rod_len).numpy()
-    if pairs.shape[0]:
-        pairs = pairs[layer._nonlocal(pairs, arcs.numpy())]  # not the local-barrier pairs
+    pairs = layer.nonlocal_pairs(x, rest)  # not the pairs only the local barrier sees
     w1 = np.zeros(m.edge_count)
     n1 = np.zeros((m.edge_count, 3))
     w2 = np.zeros(m.edge_count)

@@ -12,12 +12,12 @@ wrapping):
 
     rho_e = r0_e lambda_bar_e^-nu_e,   lambda_bar_e = sum_k W_ek l_k / l_bar_k.
 
-The pair kernel evaluates each pair at the given radii (``radius_given``: no derivative
-through the edge lengths) and returns, per pair p of edges (a, b), with R = rho_a + rho_b,
-E_R = dE_p/dR, E_RR and gR_p = d(grad_x E_p)/dR. The chain rule then gives the exact
-gradient and Hessian (f' = d rho/d lambda_bar = -nu rho/lambda_bar, f'' = nu (nu + 1)
-rho/lambda_bar^2, Lambda = d lambda_bar/dx, s_p = f'_a e_a + f'_b e_b, G_e = sum of E_R
-over the pairs holding e):
+The pair kernel evaluates each pair at the given radii (its given-radius variants: no
+derivative through the edge lengths) and returns, per pair p of edges (a, b), with
+R = rho_a + rho_b, E_R = dE_p/dR, E_RR and gR_p = d(grad_x E_p)/dR. The chain rule then
+gives the exact gradient and Hessian (f' = d rho/d lambda_bar = -nu rho/lambda_bar,
+f'' = nu (nu + 1) rho/lambda_bar^2, Lambda = d lambda_bar/dx, s_p = f'_a e_a + f'_b e_b,
+G_e = sum of E_R over the pairs holding e):
 
     g = g_x + Lambda^T (G f'),
     H = H_xx + sum_k c_k Hess(l_k) + B Lambda + Lambda^T B^T + Lambda^T C Lambda,

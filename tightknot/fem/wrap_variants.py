@@ -170,7 +170,7 @@ class ObstacleLineContact(EnergyTerm):
                    np.broadcast_to(dofs[:, None, :], hl.shape).ravel(), hl.ravel())
         return energy, grad, coo
 
-    def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
+    def max_step(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray) -> float:
         """No step limit: the rod cannot pass through an analytic line it is pressed on
         (the energy grows without bound before the axes meet)."""
         return 1.0

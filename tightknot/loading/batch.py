@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tightknot.contact.layer import ContactLayer
+from tightknot.contact.layer import ContactLayer, ContactSettings
 from tightknot.knots.scenes import KnotScene, gauge
 from tightknot.loading.tie import TieResult, knot_type_of, tie
 from tightknot.rods.builder import RodBuilder
@@ -155,10 +155,8 @@ class BatchResult:
     evaluator: BatchEvaluator | None = None
 
 
-def _layer_settings(layer: ContactLayer) -> tuple:
-    return (layer.hard_fraction, layer.core_fraction, layer.hard_relative,
-            layer._local_window, layer._gxi.shape[0], float(layer._law.numpy()[10]),
-            float(layer.exclusion[0] / layer.edge_diameter[0]))
+def _layer_settings(layer: ContactLayer) -> ContactSettings:
+    return layer.settings
 
 
 def build_batch(scenes: list[KnotScene]) -> BatchModel:

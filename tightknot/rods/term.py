@@ -58,8 +58,10 @@ class EnergyTerm(Protocol):
         system compacts its pattern between load steps)."""
         return np.zeros(0, dtype=np.int64)
 
-    def max_step(self, x: np.ndarray, dx: np.ndarray) -> float:
-        """Largest fraction in (0, 1] of the step ``dx`` [m] that keeps the term valid."""
+    def max_step(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray) -> float:
+        """Largest fraction in (0, 1] of the step ``dx`` [m] from positions ``x`` [m] that
+        keeps the term valid, at edge rest lengths ``rest`` [m] (those of the evaluation at
+        ``x``)."""
         return 1.0
 
     def check_state(self, x: np.ndarray) -> None:

@@ -25,42 +25,57 @@ What makes the answer per rod cheap, whatever the number of rods:
 
 from __future__ import annotations
 
+import contextlib
 import math
-from dataclasses import dataclass
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 import warp as wp
 
+from tightknot.contact.broad_phase import BroadPhase
 from tightknot.contact.layer import ContactLayer, pair_blocks
+from tightknot.contact.pair_kernel import Hessian
 from tightknot.rods import elastic_kernels as ek
 from tightknot.rods.elastic import ElasticForces
 from tightknot.rods.model import Model
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
 
-class BatchContactLayer(ContactLayer):
-    """The contact layer of a batch model, with per-pair energies and per-rod step bounds
-    (the base class sums them over the whole model), evaluated on the pairs of chosen rods
-    only (a rod that asked nothing this round costs no pair evaluation)."""
+class BatchBroadPhase(BroadPhase):
+    """The broad phase of a batch model, whose candidates may be kept to chosen rods (a rod
+    that asked nothing this round costs no pair evaluation), and reused from the last
+    detection when the same positions are evaluated again for some rods."""
 
     #: Rods whose candidate pairs are kept (None: all).
     rod_mask: np.ndarray | None = None
-    #: Candidate pairs of the last detection (host), reused by :meth:`pair_terms` when
-    #: asked to (the same positions evaluated again for some rods).
+    #: Candidate pairs of the last stored detection (host).
     _last_candidates: np.ndarray | None = None
     _reuse: bool = False
     _store: bool = False
 
-    def _arcs_of(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
-        # The base class loops over the rods (64 rods: about 1 ms, each time the rest
-        # lengths change; ContactLayer._arcs reuses the result while they do not).
+    @contextlib.contextmanager
+    def only(self, rods: np.ndarray, reuse: bool = False, store: bool = False
+             ) -> Iterator[None]:
+        """Within the block, the candidates of the rods in mask ``rods`` only; ``reuse``:
+        those of the last stored detection instead of a new one; ``store``: store this
+        detection's."""
+        self.rod_mask, self._reuse, self._store = rods, reuse, store
+        try:
+            yield
+        finally:
+            self.rod_mask = None
+            self._reuse = self._store = False
+
+    def arcs_of(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
+        # The base class loops over the rods in Python, each time the rest lengths change.
         # Rods of one edge count: one cumulative sum along each row of a (rods, edges)
         # view, the same additions in the same order as the loop.
         m = self.model
         counts = {r.edge_count for r in m.rods}
         if len(counts) != 1:
-            return super()._arcs_of(rest)
+            return super().arcs_of(rest)
         le = np.ascontiguousarray(rest, dtype=np.float64).reshape(len(m.rods), -1)
         s1 = np.cumsum(le, axis=1)
         arcs = np.stack([(s1 - le).ravel(), s1.ravel()], axis=1)
@@ -68,12 +83,12 @@ class BatchContactLayer(ContactLayer):
                 wp.array(np.ascontiguousarray(s1[:, -1]), dtype=wp.float64,
                          device=self.device))
 
-    def _candidates(self, wx: wp.array, wdx: wp.array, margin: wp.array, arcs: wp.array,
-                    rod_len: wp.array) -> wp.array:
+    def candidates(self, wx: wp.array, wdx: wp.array, margin: wp.array, arcs: wp.array,
+                   rod_len: wp.array) -> wp.array:
         if self._reuse:
             pn = self._last_candidates
         else:
-            pairs = super()._candidates(wx, wdx, margin, arcs, rod_len)
+            pairs = super().candidates(wx, wdx, margin, arcs, rod_len)
             if self.rod_mask is None:
                 return pairs
             pn = pairs.numpy()
@@ -83,6 +98,14 @@ class BatchContactLayer(ContactLayer):
         return wp.array(np.ascontiguousarray(pn[keep]).reshape(-1, 2), dtype=wp.vec2i,
                         device=self.device)
 
+
+class BatchContactLayer(ContactLayer):
+    """The contact layer of a batch model, with per-pair energies and per-rod step bounds
+    (the base class sums them over the whole model), evaluated on the pairs of chosen rods
+    only."""
+
+    broad_phase_class = BatchBroadPhase
+
     def pair_terms(self, x: np.ndarray, rest: np.ndarray, rods: np.ndarray,
                    tables: tuple[wp.array, ...], csc: wp.array, again: bool = False
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, wp.array, int]:
@@ -91,36 +114,26 @@ class BatchContactLayer(ContactLayer):
         count of Hessian blocks missing from ``tables`` (the Hessian is added into
         ``csc``). ``again``: the same positions as the last call, whose candidate pairs
         are reused (no new detection)."""
-        self.rod_mask = rods
-        self._reuse, self._store = again, not again
-        try:
-            pairs, e_pair, grad, _, overlap, missing = self._launch(x, rest, True, 2, tables,
-                                                                    csc)
-        finally:
-            self.rod_mask = None
-            self._reuse = self._store = False
-        self._remember(pairs, overlap)
-        return self.last_pairs, e_pair, overlap, grad, int(missing.numpy()[0])
+        with self.broad_phase.only(rods, reuse=again, store=not again):
+            out = self.energy.launch(x, rest, True, Hessian.CSC, tables, csc)
+        return self.last_pairs, out.energy, out.overlap, out.grad, int(out.missing.numpy()[0])
 
     def step_bounds(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray,
                     rods: np.ndarray) -> np.ndarray:
         """Largest fraction in [0, 1] of the step ``dx`` [m] of each rod in mask ``rods``
         that keeps its non-local segment pairs at least the hard limit apart (as
-        :meth:`max_step`)."""
-        self.rest = np.array(rest, dtype=np.float64)
-        wx = self._in_x.put(x)
-        wdx = self._in_dx.put(dx)
-        arcs, rod_len = self._arcs(self.rest)
-        self.rod_mask = rods
-        try:
-            pairs = self._candidates(wx, wdx, self._half_hard(), arcs, rod_len)
-        finally:
-            self.rod_mask = None
+        :meth:`max_step`), at edge rest lengths ``rest`` [m]."""
+        bp = self.broad_phase
+        wx = bp.x_in.put(x)
+        wdx = bp.dx_in.put(dx)
+        arcs, rod_len = bp.arcs(rest)
+        with bp.only(rods):
+            pairs = bp.candidates(wx, wdx, self.step_bound.half_hard, arcs, rod_len)
         out = np.ones(len(rods))
         n = pairs.shape[0]
         if n == 0:
             return out
-        alpha = self._step_bounds(wx, wdx, pairs)
+        alpha = self.step_bound.pair_bounds(wx, wdx, pairs)
         rod = self.model.edge_rod[pairs.numpy()[:, 0]]
         np.minimum.at(out, rod, np.clip(alpha, 0.0, 1.0))
         return out
@@ -128,18 +141,16 @@ class BatchContactLayer(ContactLayer):
 
 def batch_contact_layer(model: Model, like: ContactLayer) -> BatchContactLayer:
     """A :class:`BatchContactLayer` on ``model`` with the settings of ``like``."""
-    if getattr(like, "radius_window", 0.0) > 0.0:
+    if like.radius_window > 0.0:
         # Its Hessian couples whole windows of the rod: not the banded per-rod systems of
         # the batch (tightknot.contact.section_radius).
         raise ValueError(f"the batch does not support a contact layer with radius_window > 0 "
                          f"(got {like.radius_window:g} D0): tie these scenes one by one")
-    law_params = like._law.numpy()
-    return BatchContactLayer(
-        model, like.law, gauss_points=like._gxi.shape[0],
-        exclusion_factor=float(like.exclusion[0] / like.edge_diameter[0]),
-        hard_fraction=like.hard_fraction, core_fraction=like.core_fraction,
-        core_stiffness=float(law_params[10]), hard_relative=like.hard_relative,
-        local_thickness=like._local_window < 1.0)
+    # The batch's exclusion factor is the first edge's window over its diameter, as it has
+    # always been (for most diameters the factor itself, bit for bit).
+    settings = replace(like.settings,
+                       exclusion_factor=float(like.exclusion[0] / like.edge_diameter[0]))
+    return BatchContactLayer(model, like.law, **settings.as_kwargs())
 
 
 @dataclass

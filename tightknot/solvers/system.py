@@ -329,7 +329,7 @@ class RodSystem:
             return 1.0
         x0 = self.positions(u)
         dx = self.positions(u + du) - x0
-        return min(term.max_step(x0, dx) for term in self.extra_terms)
+        return min(term.max_step(x0, dx, self.rest) for term in self.extra_terms)
 
     def has_trial(self, u: np.ndarray) -> bool:
         """The last evaluation was at ``u`` (its frames are at hand for :meth:`accept`)."""

@@ -1,0 +1,149 @@
+"""No passing through: the largest fraction of a step that keeps every non-local pair of
+segments at least the hard limit apart along the straight path.
+
+Segment distance is 1-Lipschitz in the motion of its points, and each point of an edge moves
+at most max(|dx| of its two vertices) along the straight step; so no point pair comes closer
+than d0 - alpha (m_a + m_b), and alpha = (d0 - hard)/(m_a + m_b) keeps the pair at least
+``hard`` apart along the whole step: no passing through by construction. The candidates are
+the pairs whose bounds, swept by the step and inflated by half the hard limit, overlap.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import warp as wp
+
+from tightknot.contact.broad_phase import BroadPhase
+from tightknot.contact.kernel_module import KERNEL_MODULE
+from tightknot.rods.staging import Launches, Output
+
+f64 = wp.float64
+
+
+@wp.func
+def segment_distance(p0: wp.vec3d, p1: wp.vec3d, q0: wp.vec3d, q1: wp.vec3d) -> wp.vec3d:
+    """Closest points of segments [p0, p1], [q0, q1]: returns (distance, s, t).
+
+    Ericson, "Real-Time Collision Detection" (2005) sec. 5.1.9, with the parallel and
+    zero-length cases handled.
+    """
+    d1 = p1 - p0
+    d2 = q1 - q0
+    r = p0 - q0
+    a = wp.dot(d1, d1)
+    e = wp.dot(d2, d2)
+    f = wp.dot(d2, r)
+    tiny = f64(1.0e-30)
+    s = f64(0.0)
+    t = f64(0.0)
+    if a <= tiny and e <= tiny:
+        s = f64(0.0)
+        t = f64(0.0)
+    elif a <= tiny:
+        s = f64(0.0)
+        t = wp.clamp(f / e, f64(0.0), f64(1.0))
+    else:
+        c = wp.dot(d1, r)
+        if e <= tiny:
+            t = f64(0.0)
+            s = wp.clamp(-c / a, f64(0.0), f64(1.0))
+        else:
+            b = wp.dot(d1, d2)
+            denom = a * e - b * b
+            if denom > f64(1.0e-14) * a * e:
+                s = wp.clamp((b * f - c * e) / denom, f64(0.0), f64(1.0))
+            else:
+                s = f64(0.0)  # parallel: any s works; pick an end
+            t = (b * s + f) / e
+            if t < f64(0.0):
+                t = f64(0.0)
+                s = wp.clamp(-c / a, f64(0.0), f64(1.0))
+            elif t > f64(1.0):
+                t = f64(1.0)
+                s = wp.clamp((b - c) / a, f64(0.0), f64(1.0))
+    cp = p0 + s * d1
+    cq = q0 + t * d2
+    return wp.vec3d(wp.length(cp - cq), s, t)
+
+
+@wp.kernel(module=KERNEL_MODULE)
+def step_bound_kernel(
+    # Model:
+    edge_vertex: wp.array(dtype=wp.vec2i),
+    edge_hard: wp.array(dtype=wp.float64),
+    # Data in:
+    x_in: wp.array(dtype=wp.vec3d),
+    dx_in: wp.array(dtype=wp.vec3d),
+    pairs_in: wp.array(dtype=wp.vec2i),
+    # Out:
+    alpha_out: wp.array(dtype=wp.float64),
+    distance_out: wp.array(dtype=wp.float64),
+):
+    # Each pair's largest step fraction (module docstring) and its segment distance.
+    p = wp.tid()
+    pr = pairs_in[p]
+    va = edge_vertex[pr[0]]
+    vb = edge_vertex[pr[1]]
+    res = segment_distance(x_in[va[0]], x_in[va[1]], x_in[vb[0]], x_in[vb[1]])
+    d0 = res[0]
+    distance_out[p] = d0
+    ma = wp.max(wp.length(dx_in[va[0]]), wp.length(dx_in[va[1]]))
+    mb = wp.max(wp.length(dx_in[vb[0]]), wp.length(dx_in[vb[1]]))
+    hard = wp.max(edge_hard[pr[0]], edge_hard[pr[1]])
+    move = ma + mb
+    alpha = f64(1.0e30)
+    if move > f64(0.0):
+        alpha = (d0 - hard) / move
+    alpha_out[p] = alpha
+
+
+class StepBound:
+    """The step bound of a layer's edges, and the segment distances of candidate pairs.
+
+    Args:
+        broad: the layer's broad phase.
+        edge_hard: hard limit of each edge [m]: a pair's is the larger of its two edges'.
+    """
+
+    def __init__(self, broad: BroadPhase, edge_hard: np.ndarray) -> None:
+        dev = broad.device
+        self.broad = broad
+        self.device = dev
+        #: Hard limit of each edge [m] (host).
+        self.edge_hard = np.asarray(edge_hard, dtype=np.float64)
+        self._hard = wp.array(self.edge_hard, dtype=f64, device=dev)
+        #: Bounds margin of the step's candidates: half the hard limit [m] per edge.
+        self.half_hard = wp.array(0.5 * self.edge_hard, dtype=f64, device=dev)
+        self._alpha = Output(wp.float64, dev)
+        self._dist = Output(wp.float64, dev)
+        self._launches = Launches()
+
+    def max_step(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray) -> float:
+        """Largest fraction of the step ``dx`` [m] (vertices) from positions ``x`` [m] that
+        keeps every non-local segment pair at least the hard limit apart along the straight
+        path (1 = full); ``rest``: edge rest lengths [m] (the exclusion window is measured
+        along the rest arcs)."""
+        broad = self.broad
+        wx = broad.x_in.put(x)
+        wdx = broad.dx_in.put(dx)
+        arcs, rod_len = broad.arcs(rest)
+        pairs = broad.candidates(wx, wdx, self.half_hard, arcs, rod_len)
+        if pairs.shape[0] == 0:
+            return 1.0
+        alpha = self.pair_bounds(wx, wdx, pairs)
+        return float(np.clip(alpha.min(), 0.0, 1.0))
+
+    def pair_bounds(self, wx: wp.array, wdx: wp.array, pairs: wp.array) -> np.ndarray:
+        """Each pair's largest step fraction (host copy; step_bound_kernel); the pairs'
+        segment distances [m] are kept for :meth:`distances`."""
+        n = pairs.shape[0]
+        alpha = self._alpha.get(n)  # written for every pair: no zeroing needed
+        dist = self._dist.get(n)
+        self._launches.launch(step_bound_kernel, n, self.device,
+                              [self.broad.edge_vertex, self._hard, wx, wdx,
+                               self.broad.buffer_of(pairs)], [alpha, dist])
+        return self._alpha.numpy(n)
+
+    def distances(self, n: int) -> np.ndarray:
+        """Segment distances [m] of the first ``n`` pairs of the last :meth:`pair_bounds`."""
+        return self._dist.numpy(n)
