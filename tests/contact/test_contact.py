@@ -92,7 +92,7 @@ def test_parallel_strands_follow_the_line_law(delta_over_d: float) -> None:
     # hard core is moved out of the way (core_fraction 0.3) to see the law alone.
     d = (1.0 - delta_over_d) * D
     m = two_rods(0.0, d, n=161)
-    cl = ContactLayer(m, LAW, gauss_points=2, core_fraction=0.3)
+    cl = ContactLayer(m, LAW, gauss_points=2, core_fraction=0.3, hard_relative=0.0)
     _, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
     h = m.edge_rest_length[0]
     f_model = -g[m.rods[1].vertex_start + 80, 2] / h
@@ -112,7 +112,7 @@ def test_crossed_strands_follow_the_point_law(delta_over_d: float) -> None:
     # alone: hard core out of the way, as above).
     d = (1.0 - delta_over_d) * D
     m = two_rods(90.0, d, n=161)
-    cl = ContactLayer(m, LAW, gauss_points=2, core_fraction=0.3)
+    cl = ContactLayer(m, LAW, gauss_points=2, core_fraction=0.3, hard_relative=0.0)
     _, g, _ = cl.evaluate(m.vertex_initial_position, m.edge_rest_length, True, False)
     f_model = -g[m.rods[1].vertex_slice, 2].sum()
     f_law = float(LAW.point_force(delta_over_d * D - LAW.onset_band * D, E, D))

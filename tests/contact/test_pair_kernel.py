@@ -82,7 +82,10 @@ def test_the_variants_agree(window: float) -> None:
 def test_settings_are_one_record() -> None:
     m = two_rods(90.0, 2.0 * D, n=5)
     layer = ContactLayer(m, hard_fraction=0.1, local_thickness=True)
-    assert layer.settings == ContactSettings(hard_fraction=0.1, local_thickness=True)
+    law = layer.law  # the core comes from the law's calibration
+    assert layer.settings == ContactSettings(
+        hard_fraction=0.1, local_thickness=True, core_fraction=law.core_fraction,
+        hard_relative=law.core_hard_relative, core_stiffness=law.core_stiffness)
     assert layer.settings.candidate_window == 0.5
     assert ContactLayer(m, layer.law, **layer.settings.as_kwargs()).settings == layer.settings
     rigid = ContactLayer(m, layer.law.rigid_tube())

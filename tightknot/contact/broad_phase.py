@@ -167,8 +167,11 @@ class BroadPhase:
         self._upper = wp.empty(model.edge_count, dtype=wp.vec3, device=dev)
         self._capacity = int(initial_capacity)
         self._alloc(self._capacity)
-        #: (rest lengths, their arc tables) of the last :meth:`arcs` call.
-        self._arcs_memo: tuple[np.ndarray, tuple[wp.array, wp.array]] | None = None
+        #: Scale of each edge's rest length in the arcs the window is judged by [-]: the
+        #: window follows the deformed rod (ContactLayer.begin_load_step); 1 at rest.
+        self.window_scale = np.ones(model.edge_count)
+        #: (rest lengths, window scale, their arc tables) of the last :meth:`arcs` call.
+        self._arcs_memo: tuple[np.ndarray, np.ndarray, tuple[wp.array, wp.array]] | None = None
         self._launches = Launches()
 
     def _alloc(self, capacity: int) -> None:
@@ -177,16 +180,18 @@ class BroadPhase:
 
     # -- rest arcs -------------------------------------------------------------------------
     def arcs(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
-        """Rest arc lengths [m] of each edge's ends (vec2d per edge) and each rod's rest
-        length [m], for edge rest lengths ``rest`` [m]."""
-        # Rest arcs change once per load step but are asked for at every evaluation and
+        """Arc lengths [m] of each edge's ends (vec2d per edge) and each rod's length [m]
+        that the exclusion window is judged by: the edge rest lengths ``rest`` [m] times
+        :attr:`window_scale`."""
+        # The arcs change once per load step but are asked for at every evaluation and
         # step bound (a Python loop over the rods and two device copies each time): reused
-        # while the rest lengths are the same.
+        # while the rest lengths and the scale are the same.
         memo = self._arcs_memo
-        if memo is not None and np.array_equal(memo[0], rest):
-            return memo[1]
-        out = self.arcs_of(rest)
-        self._arcs_memo = (np.array(rest, dtype=np.float64), out)
+        if (memo is not None and np.array_equal(memo[0], rest)
+                and np.array_equal(memo[1], self.window_scale)):
+            return memo[2]
+        out = self.arcs_of(np.asarray(rest, dtype=np.float64) * self.window_scale)
+        self._arcs_memo = (np.array(rest, dtype=np.float64), self.window_scale.copy(), out)
         return out
 
     def arcs_of(self, rest: np.ndarray) -> tuple[wp.array, wp.array]:
@@ -205,11 +210,14 @@ class BroadPhase:
 
     # -- candidates ------------------------------------------------------------------------
     def candidates(self, wx: wp.array, wdx: wp.array, margin: wp.array, arcs: wp.array,
-                   rod_len: wp.array) -> wp.array:
+                   rod_len: wp.array, window: float | None = None) -> wp.array:
         """Candidate edge pairs (a < b, vec2i) at positions ``wx`` [m] whose bounds, swept
         by the step ``wdx`` [m] and inflated by ``margin`` [m] per edge, overlap; ``arcs``,
-        ``rod_len`` from :meth:`arcs`. A prefix of the candidate buffer (see
-        :meth:`buffer_of`), valid until the next query."""
+        ``rod_len`` from :meth:`arcs`; ``window``: the candidate window over the exclusion
+        window (default :attr:`candidate_window`; 0: every pair sharing no vertex). A
+        prefix of the candidate buffer (see :meth:`buffer_of`), valid until the next
+        query."""
+        window = self.candidate_window if window is None else float(window)
         m = self.model
         dev = self.device
         lower, upper = self._lower, self._upper
@@ -221,7 +229,7 @@ class BroadPhase:
             # Not a recorded launch: the BVH is new at every call.
             wp.launch(candidate_pairs_kernel, dim=m.edge_count, device=dev,
                       inputs=[self.edge_vertex, self.edge_rod, self.rod_closed,
-                              self.edge_exclusion, self.candidate_window, bvh.id, lower,
+                              self.edge_exclusion, window, bvh.id, lower,
                               upper, arcs, rod_len, self._capacity],
                       outputs=[self._count, self._pairs])
             n = int(self._count.numpy()[0])

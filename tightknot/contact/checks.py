@@ -46,7 +46,7 @@ class ContactChecks:
         n = pairs.shape[0]
         if n == 0:
             return np.zeros((0, 2), dtype=np.int32), np.zeros(0), arcs.numpy()
-        self.step_bound.pair_bounds(wx, broad.zero_dx, pairs)
+        self.step_bound.pair_bounds(wx, broad.zero_dx, pairs, arcs, rod_len)
         return pairs.numpy(), self.step_bound.distances(n), arcs.numpy()
 
     def check_no_intersection(self, x: np.ndarray, rest: np.ndarray) -> None:

@@ -94,6 +94,13 @@ class RadialComplianceLaw:
             a line contact and above which it is a point contact.
         rigid: a rigid-tube law (stiff, for comparison): the outputs of a deformable
             section (width, pressure, area) are then reported as zero / unchanged.
+        core_fraction, core_hard_relative, core_stiffness: the hard core that stiffens the
+            contact of deep squeezes (the contact layer's barrier: from the centerline
+            distance core_fraction R, diverging at core_hard_relative R, stiffness over
+            E/D), fitted together with the power laws to the FEM's deep squeezes
+            (:func:`tightknot.fem.calibration.calibrate_core`); None: the layer's defaults.
+        calibrated_w_hat: the largest per-side approach w/D the law (with its core) was
+            calibrated to [-]: a state beyond it is outside the calibrated range.
         source: where the parameters come from.
     """
 
@@ -117,6 +124,10 @@ class RadialComplianceLaw:
     angle_line_deg: float = 15.0
     angle_point_deg: float = 35.0
     rigid: bool = False
+    core_fraction: float | None = None
+    core_hard_relative: float | None = None
+    core_stiffness: float | None = None
+    calibrated_w_hat: float = 0.15
     source: str = "parameters"
 
     def __post_init__(self) -> None:
@@ -175,8 +186,15 @@ class RadialComplianceLaw:
         layer then keeps the rest radius instead of thinning it with stretch)."""
         return replace(self, k_line=self.k_line * stiffness, k_point=self.k_point * stiffness,
                        p_line=max(self.p_line, 1.0), p_point=max(self.p_point, 1.0),
-                       onset_band=2e-3, rigid=True,
+                       onset_band=2e-3, rigid=True, core_fraction=None,
+                       core_hard_relative=None, core_stiffness=None,
                        source=f"rigid tube ({stiffness:g} x {self.source})")
+
+    def without_core(self) -> RadialComplianceLaw:
+        """The power laws alone: the contact layer then takes its default barrier, which
+        starts only where the power laws' calibration ends (pair overlap 0.3 R)."""
+        return replace(self, core_fraction=None, core_hard_relative=None, core_stiffness=None,
+                       source=f"{self.source} without its core")
 
     def as_dict(self) -> dict:
         """Parameters as a JSON-ready dict."""

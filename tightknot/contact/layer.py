@@ -60,23 +60,20 @@ class ContactLayer(EnergyTerm):
             of the stretched sections), diverging at rho_h = max(hard_relative R,
             hard_fraction D + 0.58 l) (l the longer rest edge: every polyline point is
             within 0.29 l of a Gauss point, so the barrier stops two segments before the
-            step bound would). Default 0.7 for a compliant law: the barrier takes over where
-            the FEM calibration ends (pair overlap 0.3 R); beyond it the power law alone is
-            far too soft (measured: a tight 125 mm trefoil pulled past 7 N snapped to a gap
-            of 0.12 D0, sections squeezed to a third), whereas an incompressible section
-            stiffens. Default 1.0 for a rigid tube.
+            step bound would). Default: the law's calibrated core (an incompressible section
+            stiffens steeply in deep squeezes, which the power laws alone miss:
+            :func:`tightknot.fem.calibration.calibrate_core`), else 0.7 for a compliant law
+            (the end of the power laws' calibrated range) and 1.0 for a rigid tube.
         core_stiffness: the barrier's stiffness over E/D (energy per length^2 over the
-            square of the distance into the band).
-        hard_relative: see core_fraction; default 0 (compliant: only the absolute floor),
-            0.98 for a rigid tube (its hard radius: the barrier diverges at 0.98 R).
+            square of the distance into the band); default the law's core, else 1.
+        hard_relative: see core_fraction; default the law's core, else 0 (compliant: only
+            the absolute floor) or 0.98 for a rigid tube (its hard radius).
         local_thickness: also guard pairs of one rod inside the exclusion window, down to
             half of it: two points an arc s apart on the tightest legal bend (radius D/2)
-            are D sin(s/D) apart, and the barrier acts below 0.7 of that (with R for D), so
-            the rod cannot fold onto itself where the law is off. Off by default: measured
-            on a tight 125 mm trefoil pulled to 2x its tightening force, it turned a fold
-            that jammed Newton at the step bound (legs 0.05 D apart) into one held at
-            0.42 D, but it changes the load path of the marginal 185 mm knot (which then
-            slides off its tail when loosened to Lambda_OC 15), and it adds candidates.
+            are D sin(s/D) apart, and the barrier acts below core_fraction of that (with R
+            for D), so the rod cannot fold onto itself where the law is off. Off by
+            default: it changes the load path of marginal knots and adds candidates
+            (docs/design_notes.md, contact).
         initial_capacity: first size of the candidate-pair buffer (grows on demand).
         radius_window: half-width [D0] of the window along the rod over which the stretch
             that thins the contact radius is averaged (:mod:`tightknot.contact.section_radius`);
@@ -102,7 +99,7 @@ class ContactLayer(EnergyTerm):
         exclusion_factor: float = math.pi / 2,
         hard_fraction: float = 0.05,
         core_fraction: float | None = None,
-        core_stiffness: float = 1.0,
+        core_stiffness: float | None = None,
         hard_relative: float | None = None,
         local_thickness: bool = False,
         initial_capacity: int = 1024,
@@ -111,10 +108,19 @@ class ContactLayer(EnergyTerm):
         init_warp()
         self.law = law or RadialComplianceLaw.from_json()
         rigid = self.law.rigid
+        # The hard core: the law's calibrated one, else a rigid tube's hard radius (0.98 R)
+        # or, for a compliant law without one, a barrier from 0.7 R (the end of the power
+        # laws' calibrated range) down to the absolute floor.
         if core_fraction is None:
-            core_fraction = 1.0 if rigid else 0.7
+            core_fraction = (self.law.core_fraction if self.law.core_fraction is not None
+                             else 1.0 if rigid else 0.7)
         if hard_relative is None:
-            hard_relative = 0.98 if rigid else 0.0
+            hard_relative = (self.law.core_hard_relative
+                             if self.law.core_hard_relative is not None
+                             else 0.98 if rigid else 0.0)
+        if core_stiffness is None:
+            core_stiffness = (self.law.core_stiffness if self.law.core_stiffness is not None
+                              else 1.0)
         #: The layer's settings (checked; the batch compares them).
         self.settings = ContactSettings(
             gauss_points=gauss_points, exclusion_factor=exclusion_factor,
@@ -132,6 +138,8 @@ class ContactLayer(EnergyTerm):
         self.edge_diameter = 2.0 * m.edge_radius
         # A rigid tube has a hard radius: its contact radius does not thin with stretch.
         nu = np.array([0.0 if rigid else m.rods[r].material.poisson_ratio for r in m.edge_rod])
+        #: Exponent of each edge's section thinning with stretch, r0 lam^-nu (0: rigid).
+        self.edge_poisson = nu
         #: Young's modulus of each edge [Pa].
         self.edge_modulus = np.array([m.rods[r].material.youngs_modulus for r in m.edge_rod])
         #: Exclusion window of each edge [m].
@@ -143,7 +151,8 @@ class ContactLayer(EnergyTerm):
         kernel = PairKernel(self.broad_phase, pair_law(self.law, st, self.device), st.gauss,
                             m.edge_radius, nu, self.edge_modulus)
         self.energy = ContactEnergy(m, self.broad_phase, kernel, smooth)
-        self.step_bound = StepBound(self.broad_phase, st.hard_fraction * self.edge_diameter)
+        self.step_bound = StepBound(self.broad_phase, st.hard_fraction * self.edge_diameter,
+                                    self.edge_diameter)
         self.checks = ContactChecks(self.broad_phase, self.step_bound, st.hard_fraction)
 
     # -- settings --------------------------------------------------------------------------
@@ -219,6 +228,29 @@ class ContactLayer(EnergyTerm):
     def check_state(self, x: np.ndarray) -> None:
         """:meth:`check_no_intersection` (the system's check of a start)."""
         self.check_no_intersection(x)
+
+    def window_scale(self, lengths: np.ndarray, rest: np.ndarray,
+                     edges: slice = slice(None)) -> np.ndarray:
+        """The scale of the rest arcs that makes the exclusion window follow the deformed
+        rod, for edges ``edges`` of current lengths ``lengths`` [m] and rest lengths
+        ``rest`` [m]: lam^(1 + nu) of a stretched edge (lam = length / rest), 1 otherwise.
+
+        The window (pi D / 2 of arc: on the tightest bend a tube allows, two points closer
+        along it than that are closer than D, module docstring of the broad phase) holds
+        for the deformed rod: its arc grows as lam and its diameter thins as lam^-nu, so in
+        rest arcs and rest diameters the window shrinks by lam^(1 + nu). A pair that a
+        stretched, thinned knot brings into contact is then no longer taken for a
+        neighbour. Compressed edges keep the rest window (it never widens)."""
+        lam = np.asarray(lengths, dtype=np.float64) / np.asarray(rest, dtype=np.float64)
+        return np.maximum(lam, 1.0) ** (1.0 + self.edge_poisson[edges])
+
+    def begin_load_step(self, x: np.ndarray, rest: np.ndarray) -> None:
+        """At a new load step, the window follows the rod as it is at the step's start
+        (:meth:`window_scale`; fixed through the step, so that the energy is one smooth
+        function of the positions within it)."""
+        ev = self.model.edge_vertex
+        lengths = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
+        self.broad_phase.window_scale = self.window_scale(lengths, rest)
 
     # -- measurements ----------------------------------------------------------------------
     def section_stretch(self, x: np.ndarray, rest: np.ndarray) -> np.ndarray:

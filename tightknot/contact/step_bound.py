@@ -1,11 +1,16 @@
-"""No passing through: the largest fraction of a step that keeps every non-local pair of
-segments at least the hard limit apart along the straight path.
+"""No passing through: the largest fraction of a step that keeps every pair of segments
+sharing no vertex at least its floor apart along the straight path.
 
 Segment distance is 1-Lipschitz in the motion of its points, and each point of an edge moves
 at most max(|dx| of its two vertices) along the straight step; so no point pair comes closer
-than d0 - alpha (m_a + m_b), and alpha = (d0 - hard)/(m_a + m_b) keeps the pair at least
-``hard`` apart along the whole step: no passing through by construction. The candidates are
-the pairs whose bounds, swept by the step and inflated by half the hard limit, overlap.
+than d0 - alpha (m_a + m_b), and alpha = (d0 - floor)/(m_a + m_b) keeps the pair at least
+``floor`` apart along the whole step: no passing through by construction. Every pair counts,
+neighbours along the rod too (the energy may not watch them: the exclusion window). The
+floor of a pair is the hard limit (``hard_fraction`` D), or, for two edges of one rod whose
+nearest ends are an arc s apart, ``local_fraction`` D sin(min(s/D, pi/2)) where smaller: a
+quarter of the chord between two points an arc s apart on the tightest bend a tube of
+diameter D allows, so a legal bend is never blocked. The candidates are the pairs whose
+bounds, swept by the step and inflated by half the hard limit, overlap.
 """
 
 from __future__ import annotations
@@ -13,11 +18,15 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from tightknot.contact.broad_phase import BroadPhase
+from tightknot.contact.broad_phase import BroadPhase, arc_separation
 from tightknot.contact.kernel_module import KERNEL_MODULE
 from tightknot.rods.staging import Launches, Output
 
 f64 = wp.float64
+
+#: Floor of near pairs of one rod over the tightest legal bend's chord (module docstring).
+LOCAL_FRACTION = 0.25
+HALF_PI = wp.constant(wp.float64(1.5707963267948966))
 
 
 @wp.func
@@ -66,15 +75,44 @@ def segment_distance(p0: wp.vec3d, p1: wp.vec3d, q0: wp.vec3d, q1: wp.vec3d) -> 
     return wp.vec3d(wp.length(cp - cq), s, t)
 
 
+@wp.func
+def pair_floor(a: int, b: int, edge_rod: wp.array(dtype=wp.int32),
+               rod_closed: wp.array(dtype=wp.int32), edge_hard: wp.array(dtype=wp.float64),
+               edge_diameter: wp.array(dtype=wp.float64), local_fraction: wp.float64,
+               edge_arc: wp.array(dtype=wp.vec2d), rod_length: wp.array(dtype=wp.float64)
+               ) -> wp.float64:
+    """The floor [m] of edge pair (a, b) (module docstring)."""
+    hard = wp.max(edge_hard[a], edge_hard[b])
+    ra = edge_rod[a]
+    if edge_rod[b] != ra:
+        return hard
+    arc_a = edge_arc[a]
+    arc_b = edge_arc[b]
+    closed = rod_closed[ra]
+    length = rod_length[ra]
+    sep = wp.min(wp.min(arc_separation(arc_a[0], arc_b[1], 1, closed, length),
+                        arc_separation(arc_a[1], arc_b[0], 1, closed, length)),
+                 wp.min(arc_separation(arc_a[0], arc_b[0], 1, closed, length),
+                        arc_separation(arc_a[1], arc_b[1], 1, closed, length)))
+    d = wp.max(edge_diameter[a], edge_diameter[b])
+    return wp.min(hard, local_fraction * d * wp.sin(wp.min(sep / d, HALF_PI)))
+
+
 @wp.kernel(module=KERNEL_MODULE)
 def step_bound_kernel(
     # Model:
     edge_vertex: wp.array(dtype=wp.vec2i),
+    edge_rod: wp.array(dtype=wp.int32),
+    rod_closed: wp.array(dtype=wp.int32),
     edge_hard: wp.array(dtype=wp.float64),
+    edge_diameter: wp.array(dtype=wp.float64),
+    local_fraction: wp.float64,
     # Data in:
     x_in: wp.array(dtype=wp.vec3d),
     dx_in: wp.array(dtype=wp.vec3d),
     pairs_in: wp.array(dtype=wp.vec2i),
+    edge_arc_in: wp.array(dtype=wp.vec2d),
+    rod_length_in: wp.array(dtype=wp.float64),
     # Out:
     alpha_out: wp.array(dtype=wp.float64),
     distance_out: wp.array(dtype=wp.float64),
@@ -89,7 +127,8 @@ def step_bound_kernel(
     distance_out[p] = d0
     ma = wp.max(wp.length(dx_in[va[0]]), wp.length(dx_in[va[1]]))
     mb = wp.max(wp.length(dx_in[vb[0]]), wp.length(dx_in[vb[1]]))
-    hard = wp.max(edge_hard[pr[0]], edge_hard[pr[1]])
+    hard = pair_floor(pr[0], pr[1], edge_rod, rod_closed, edge_hard, edge_diameter,
+                      local_fraction, edge_arc_in, rod_length_in)
     move = ma + mb
     alpha = f64(1.0e30)
     if move > f64(0.0):
@@ -105,10 +144,14 @@ class StepBound:
         edge_hard: hard limit of each edge [m]: a pair's is the larger of its two edges'.
     """
 
-    def __init__(self, broad: BroadPhase, edge_hard: np.ndarray) -> None:
+    def __init__(self, broad: BroadPhase, edge_hard: np.ndarray,
+                 edge_diameter: np.ndarray, local_fraction: float = LOCAL_FRACTION) -> None:
         dev = broad.device
         self.broad = broad
         self.device = dev
+        self.local_fraction = float(local_fraction)
+        self._diameter = wp.array(np.asarray(edge_diameter, dtype=np.float64), dtype=f64,
+                                  device=dev)
         #: Hard limit of each edge [m] (host).
         self.edge_hard = np.asarray(edge_hard, dtype=np.float64)
         self._hard = wp.array(self.edge_hard, dtype=f64, device=dev)
@@ -120,28 +163,32 @@ class StepBound:
 
     def max_step(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray) -> float:
         """Largest fraction of the step ``dx`` [m] (vertices) from positions ``x`` [m] that
-        keeps every non-local segment pair at least the hard limit apart along the straight
-        path (1 = full); ``rest``: edge rest lengths [m] (the exclusion window is measured
-        along the rest arcs)."""
+        keeps every segment pair sharing no vertex at least its floor apart along the
+        straight path (1 = full); ``rest``: edge rest lengths [m] (the arcs of the near
+        pairs' floors, :meth:`BroadPhase.arcs`)."""
         broad = self.broad
         wx = broad.x_in.put(x)
         wdx = broad.dx_in.put(dx)
         arcs, rod_len = broad.arcs(rest)
-        pairs = broad.candidates(wx, wdx, self.half_hard, arcs, rod_len)
+        pairs = broad.candidates(wx, wdx, self.half_hard, arcs, rod_len, window=0.0)
         if pairs.shape[0] == 0:
             return 1.0
-        alpha = self.pair_bounds(wx, wdx, pairs)
+        alpha = self.pair_bounds(wx, wdx, pairs, arcs, rod_len)
         return float(np.clip(alpha.min(), 0.0, 1.0))
 
-    def pair_bounds(self, wx: wp.array, wdx: wp.array, pairs: wp.array) -> np.ndarray:
-        """Each pair's largest step fraction (host copy; step_bound_kernel); the pairs'
-        segment distances [m] are kept for :meth:`distances`."""
+    def pair_bounds(self, wx: wp.array, wdx: wp.array, pairs: wp.array, arcs: wp.array,
+                    rod_len: wp.array) -> np.ndarray:
+        """Each pair's largest step fraction (host copy; step_bound_kernel) at the arcs
+        ``arcs``, ``rod_len`` (:meth:`BroadPhase.arcs`); the pairs' segment distances [m]
+        are kept for :meth:`distances`."""
         n = pairs.shape[0]
         alpha = self._alpha.get(n)  # written for every pair: no zeroing needed
         dist = self._dist.get(n)
+        b = self.broad
         self._launches.launch(step_bound_kernel, n, self.device,
-                              [self.broad.edge_vertex, self._hard, wx, wdx,
-                               self.broad.buffer_of(pairs)], [alpha, dist])
+                              [b.edge_vertex, b.edge_rod, b.rod_closed, self._hard,
+                               self._diameter, self.local_fraction, wx, wdx,
+                               b.buffer_of(pairs), arcs, rod_len], [alpha, dist])
         return self._alpha.numpy(n)
 
     def distances(self, n: int) -> np.ndarray:

@@ -66,6 +66,9 @@ def register(subparsers: Any) -> None:
     cal.add_argument("--mesh", default="medium", help="coarse | medium | fine")
     cal.add_argument("--out", default=None, metavar="PATH",
                      help="output JSON (default: the package's data/contact_law.json)")
+    cal.add_argument("--core", action="store_true",
+                     help="only fit the hard core to deep plane-strain squeezes and add it to "
+                          "the law file (the power laws are kept)")
     cal.set_defaults(handler=_run_calibrate)
 
 
@@ -150,8 +153,13 @@ def _run_calibrate(args: argparse.Namespace) -> int:
     if problem:
         return _fail(problem)
     try:
-        from .calibration import LAW_PATH, write_law
+        from .calibration import LAW_PATH, write_core, write_law
 
+        if args.core:
+            core = write_core(args.out or LAW_PATH, mesh=args.mesh)
+            print(json.dumps({k: v for k, v in core.items() if k != "core_fit"} |
+                             {"max_rel_error": core["core_fit"]["max_rel_error"]}, indent=2))
+            return 0
         law = write_law(args.out or LAW_PATH, mesh=args.mesh)
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))

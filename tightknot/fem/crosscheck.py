@@ -241,11 +241,19 @@ def _indent_footprint(fem: dict[str, Any], rod: dict[str, Any]) -> dict[str, Any
 
 def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
     """The wrap with kernel variants (:mod:`tightknot.fem.wrap_variants`) against the FEM."""
+    from tightknot.contact.law import RadialComplianceLaw
+
     from .wrap_variants import rod_wrap_variant
 
     out = []
-    for kernel, footprint in WRAP_VARIANTS:
-        res = _rod_wrap_like(fem_wrap, rod_wrap_variant, kernel=kernel, footprint=footprint)
+    # The variants leave out the hard core: the rod model without it is their reference.
+    coreless = RadialComplianceLaw.from_json().without_core()
+    runs = [("warp_without_core", None,
+             _rod_wrap_like(fem_wrap, law=coreless))]
+    runs += [(kernel, footprint, _rod_wrap_like(fem_wrap, rod_wrap_variant, kernel=kernel,
+                                                footprint=footprint, law=coreless))
+             for kernel, footprint in WRAP_VARIANTS]
+    for kernel, footprint, res in runs:
         levels = []
         for f, r in zip(fem_wrap["steps"], res["steps"], strict=True):
             if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9:
@@ -255,7 +263,7 @@ def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
                 "force_rel": relative(r["force_per_length_mid"],
                                       f["force_per_length_mid_nominal"]),
                 "curvature_rel": relative(r["kappa_d0_mid"], f["kappa_d0_mid_nominal"]),
-                "rod_contact_half_length_over_d0": r["contact_half_length_over_d0"],
+                "rod_contact_half_length_over_d0": r.get("contact_half_length_over_d0"),
                 "converged": bool(r["converged"]),
             })
         out.append({"kernel": kernel, "footprint": footprint, "levels": levels,
@@ -263,7 +271,8 @@ def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
     return {
         "what": "diagnostic: the wrap's mid line load and curvature with variants of the "
                 "pair kernel (tightknot/fem/wrap_variants.py: point kernel with its "
-                "footprint shrunk by 'footprint', or the line law), relative to the FEM",
+                "footprint shrunk by 'footprint', or the line law), relative to the FEM; "
+                "all without the hard core, the first the rod model's own kernel",
         "variants": out,
     }
 

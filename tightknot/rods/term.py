@@ -33,6 +33,11 @@ class EnergyTerm(Protocol):
     #: (:class:`tightknot.rods.proximity.ProximityCheck`).
     keeps_apart: bool = False
 
+    def begin_load_step(self, x: np.ndarray, rest: np.ndarray) -> None:
+        """The system moved to a new load step: positions ``x`` [m] and edge rest lengths
+        ``rest`` [m] at its start (a term may adapt to the deformed rod once per step)."""
+        return None
+
     def evaluate(self, x: np.ndarray, rest: np.ndarray, want_grad: bool,
                  want_hess: bool) -> tuple[float, np.ndarray | None, Coo | None]:
         """Energy [J] at positions ``x`` [m] (vertex_count, 3) and edge rest lengths

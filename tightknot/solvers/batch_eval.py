@@ -84,11 +84,11 @@ class BatchBroadPhase(BroadPhase):
                          device=self.device))
 
     def candidates(self, wx: wp.array, wdx: wp.array, margin: wp.array, arcs: wp.array,
-                   rod_len: wp.array) -> wp.array:
+                   rod_len: wp.array, window: float | None = None) -> wp.array:
         if self._reuse:
             pn = self._last_candidates
         else:
-            pairs = super().candidates(wx, wdx, margin, arcs, rod_len)
+            pairs = super().candidates(wx, wdx, margin, arcs, rod_len, window)
             if self.rod_mask is None:
                 return pairs
             pn = pairs.numpy()
@@ -121,19 +121,20 @@ class BatchContactLayer(ContactLayer):
     def step_bounds(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray,
                     rods: np.ndarray) -> np.ndarray:
         """Largest fraction in [0, 1] of the step ``dx`` [m] of each rod in mask ``rods``
-        that keeps its non-local segment pairs at least the hard limit apart (as
+        that keeps its segment pairs sharing no vertex at least their floor apart (as
         :meth:`max_step`), at edge rest lengths ``rest`` [m]."""
         bp = self.broad_phase
         wx = bp.x_in.put(x)
         wdx = bp.dx_in.put(dx)
         arcs, rod_len = bp.arcs(rest)
         with bp.only(rods):
-            pairs = bp.candidates(wx, wdx, self.step_bound.half_hard, arcs, rod_len)
+            pairs = bp.candidates(wx, wdx, self.step_bound.half_hard, arcs, rod_len,
+                                  window=0.0)
         out = np.ones(len(rods))
         n = pairs.shape[0]
         if n == 0:
             return out
-        alpha = self.step_bound.pair_bounds(wx, wdx, pairs)
+        alpha = self.step_bound.pair_bounds(wx, wdx, pairs, arcs, rod_len)
         rod = self.model.edge_rod[pairs.numpy()[:, 0]]
         np.minimum.at(out, rod, np.clip(alpha, 0.0, 1.0))
         return out
@@ -332,6 +333,17 @@ class BatchEvaluator:
         """Edge rest lengths of rod k at its load step [m]."""
         r = self.rods[k]
         self.rest[r.e0 : r.e0 + r.ne] = rest
+
+    def set_window(self, k: int, x: np.ndarray, edge_vertex: np.ndarray) -> None:
+        """Rod k's exclusion window at its load step, from its positions ``x`` [m] (its own
+        frame; ``edge_vertex``: its own model's edges) and rest lengths (as
+        :meth:`tightknot.contact.layer.ContactLayer.begin_load_step`)."""
+        r = self.rods[k]
+        lengths = np.linalg.norm(x[edge_vertex[:, 1]] - x[edge_vertex[:, 0]], axis=1)
+        edges = slice(r.e0, r.e0 + r.ne)
+        scale = self.layer.broad_phase.window_scale.copy()
+        scale[edges] = self.layer.window_scale(lengths, self.rest[edges], edges)
+        self.layer.broad_phase.window_scale = scale
 
     def compact(self, k: int) -> None:
         """Drop rod k's contact blocks that no longer interact (at its new load step, as

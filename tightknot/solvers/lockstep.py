@@ -165,8 +165,10 @@ class BatchRod:
             system.linear = SparseDirect()
 
     def loaded(self, system: RodSystem) -> None:
-        """The system moved to a new load step: tell the evaluator its rest lengths."""
+        """The system moved to a new load step: tell the evaluator its rest lengths and its
+        exclusion window."""
         self.evaluator.set_rest(self.k, system.rest)
+        self.evaluator.set_window(self.k, system.state.x, system.model.edge_vertex)
         self.evaluator.compact(self.k)
 
     def cached(self, q: Evaluate) -> EvalAnswer | None:

@@ -139,6 +139,7 @@ class RodSystem:
         (``term.check_state``: a start that already violates it is refused)."""
         term.check_state(self.state.x)
         self.extra_terms.append(term)
+        term.begin_load_step(self.state.x, self.rest)
         if term.keeps_apart and self.proximity is None:
             self.proximity = ProximityCheck(self.model)
 
@@ -160,6 +161,8 @@ class RodSystem:
         d1, tt, mref = self.forces.transport_frames(x, st.d1_ref, st.t_ref, st.m_ref)
         st.x, st.d1_ref, st.t_ref, st.m_ref = x, d1, tt, mref
         self.bcs.prescribe_twist(self.t, st.theta, st.d1_ref, st.t_ref)
+        for term in self.extra_terms:
+            term.begin_load_step(st.x, self.rest)
         self._trial = None
         self.accepted_count = 0
         self.violation = None
