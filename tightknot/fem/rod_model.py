@@ -11,11 +11,14 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .material import ROD_DIAMETER, YOUNGS_MODULUS
+
+if TYPE_CHECKING:
+    from tightknot.loading.levels import LevelLoad
 
 EDGES_PER_D0: int = 12
 """Rod-model edges per diameter: the resolution of the knot scenes (closed trefoil: 200
@@ -39,47 +42,24 @@ def _line_points(start: np.ndarray, end: np.ndarray, edges: int) -> np.ndarray:
     return np.linspace(start, end, edges + 1)
 
 
-class _Path:
-    """A load value moved linearly from ``a`` to ``b`` along the load parameter t."""
-
-    def __init__(self) -> None:
-        self.a = 0.0
-        self.b = 0.0
-
-    def __call__(self, t: float) -> float:
-        return self.a + t * (self.b - self.a)
-
-    def advance(self, value: float) -> None:
-        self.a, self.b = self.b, value
-
-
-def _solve_levels(system: Any, path: _Path, levels: list[float],
+def _solve_levels(system: Any, load: LevelLoad, levels: list[float],
                   measure: Any) -> list[dict[str, Any]]:
-    """Solve each level from the last one. From the third level on, Newton starts from
-    the linear extrapolation (in the load value) of the last two equilibria (measured:
-    26 instead of 29 iterations over the wrap's 6 levels, 29 either way on the indent's
-    10); a failed solve retries smaller steps from the last equilibrium without it."""
-    from tightknot.solvers.continuation import ContinuationOptions, continuation
+    """Solve each level from the last one: one load continuation each, along which the load
+    moves linearly from the last level to this one; from the third level on, Newton starts
+    from the linear extrapolation (in the load value) of the last two equilibria (a failed
+    first step retries smaller steps from the last equilibrium without it)."""
+    from tightknot.loading.levels import LevelOptions, LevelPath, SecantPredictor
+    from tightknot.solvers.program import Program
 
+    path = LevelPath(system, load, LevelOptions(steps="linear", proximal_dt=None,
+                                                predictor=SecantPredictor()))
     rows = []
-    history: list[tuple[float, np.ndarray]] = []
     for value in levels:
-        path.advance(value)
-        predictor = None
-        if len(history) >= 2 and history[-1][0] != history[-2][0]:
-            (v1, u1), (v2, u2) = history[-2], history[-1]
-            guess = u2 + (value - v2) / (v2 - v1) * (u2 - u1)
-
-            def predictor(sys_: Any, t: float, t_next: float, guess: np.ndarray = guess
-                          ) -> None:
-                if t == 0.0 and t_next == 1.0:  # the whole level in one step only
-                    sys_.accept(guess)
-
-        result = continuation(system, ContinuationOptions(steps=1), predictor=predictor).run()
-        history.append((value, system.free_vector()))
+        it0 = path.iterations
+        why = Program(path.move_to(value), "move_to").run()
         row = measure(value)
-        row["converged"] = bool(result.converged)
-        row["newton_iterations"] = int(result.newton_iterations)
+        row["converged"] = not why
+        row["newton_iterations"] = path.iterations - it0
         rows.append(row)
     return rows
 
@@ -110,6 +90,7 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
     """
     from tightknot.contact.law import RadialComplianceLaw
     from tightknot.contact.layer import ContactLayer
+    from tightknot.loading.levels import LevelLoad
     from tightknot.rods.boundary import BoundaryConditions
     from tightknot.rods.builder import RodBuilder
     from tightknot.rods.material import Material
@@ -132,11 +113,11 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
         b.add_rod(_line_points(np.array([-2 * d0, sign * d0, 0]),
                                np.array([2 * d0, sign * d0, 0]), n_obs), d0, mat)
     model = b.finalize()
-    path = _Path()
+    load = LevelLoad()
     bcs = BoundaryConditions(model)
     for rod, sign in ((1, 1.0), (2, -1.0)):
         for k in range(n_obs + 1):
-            bcs.pin(rod, k, translation=lambda t, s=sign: np.array([0.0, -s * path(t), 0.0]))
+            bcs.pin(rod, k, translation=lambda t, s=sign: np.array([0.0, -s * load(t), 0.0]))
     mid = n_rod // 2
     for k in range(n_rod + 1):
         bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
@@ -186,22 +167,22 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "force_rms_halfwidth_over_d0": rms / d0,
         }
 
-    rows = _solve_levels(system, path, list(w_levels), measure)
+    rows = _solve_levels(system, load, list(w_levels), measure)
     return {"steps": rows, "wall_time_s": time.perf_counter() - start,
             "vertices": int(model.vertex_count), "law": pair_law.source}
 
 
-def wrap_constraints(bcs: Any, n_rod: int, theta: float, path: _Path) -> int:
+def wrap_constraints(bcs: Any, n_rod: int, theta: float, load: LevelLoad) -> int:
     """The wrapped rod's (rod 0, ``n_rod`` edges) constraints of the wrap scene: the plane
     x = 0, the symmetry plane z = 0 at its middle vertex, and dead end forces
-    ``path(t)`` (0, sin(theta), +-cos(theta)) [N]. Returns the middle vertex."""
+    ``load(t)`` (0, sin(theta), +-cos(theta)) [N]. Returns the middle vertex."""
     mid = n_rod // 2
     for k in range(n_rod + 1):
         bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
     bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
     s, c = math.sin(theta), math.cos(theta)
-    bcs.force(0, 0, lambda t: path(t) * np.array([0.0, s, -c]))
-    bcs.force(0, -1, lambda t: path(t) * np.array([0.0, s, c]))
+    bcs.force(0, 0, lambda t: load(t) * np.array([0.0, s, -c]))
+    bcs.force(0, -1, lambda t: load(t) * np.array([0.0, s, c]))
     return mid
 
 
@@ -221,6 +202,7 @@ def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     from tightknot.contact.law import RadialComplianceLaw
     from tightknot.contact.layer import ContactLayer
     from tightknot.knots.curvature import bergou_curvature
+    from tightknot.loading.levels import LevelLoad
     from tightknot.rods.boundary import BoundaryConditions
     from tightknot.rods.builder import RodBuilder
     from tightknot.rods.material import Material
@@ -244,11 +226,11 @@ def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     b.add_rod(_line_points(np.array([-2 * d0, y_obs, 0]), np.array([2 * d0, y_obs, 0]),
                            n_obs), d0, mat)
     model = b.finalize()
-    path = _Path()
+    load = LevelLoad()
     bcs = BoundaryConditions(model)
     for k in range(n_obs + 1):
         bcs.pin(1, k)
-    mid = wrap_constraints(bcs, n_rod, theta, path)
+    mid = wrap_constraints(bcs, n_rod, theta, load)
     system = RodSystem(model, State.initial(model), bcs)
     layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window)
     system.add_term(layer)
@@ -288,6 +270,6 @@ def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
             "peak_pressure_line_law_over_e": float(law.peak_pressure_line(w_side, d0)),
         }
 
-    rows = _solve_levels(system, path, list(tension_levels), measure)
+    rows = _solve_levels(system, load, list(tension_levels), measure)
     return {"steps": rows, "wall_time_s": time.perf_counter() - start,
             "vertices": int(model.vertex_count), "law": pair_law.source}

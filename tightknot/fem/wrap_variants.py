@@ -187,6 +187,7 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
     the last loaded vertex), and the wall time."""
     from tightknot.contact.law import RadialComplianceLaw
     from tightknot.knots.curvature import bergou_curvature
+    from tightknot.loading.levels import LevelLoad
     from tightknot.rods.boundary import BoundaryConditions
     from tightknot.rods.builder import RodBuilder
     from tightknot.rods.material import Material
@@ -196,7 +197,6 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
     from .rod_model import (
         DENSITY,
         EDGES_PER_D0,
-        _Path,
         _solve_levels,
         rigid_counterbody_law,
         wrap_constraints,
@@ -214,9 +214,9 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
     b.add_rod(np.linspace([0.0, 0.0, -half], [0.0, 0.0, half], n_rod + 1), d0,
               Material(youngs_modulus, 0.5, DENSITY))
     model = b.finalize()
-    path = _Path()
+    load = LevelLoad()
     bcs = BoundaryConditions(model)
-    mid = wrap_constraints(bcs, n_rod, theta, path)
+    mid = wrap_constraints(bcs, n_rod, theta, load)
     system = RodSystem(model, State.initial(model), bcs)
     term = ObstacleLineContact(model, pair_law, y_axis, kernel, footprint, youngs_modulus, d0)
     system.add_term(term)
@@ -245,6 +245,6 @@ def rod_wrap_variant(tension_levels: list[float], kernel: str = "point",
                 float(np.linalg.norm(g.sum(axis=0))) / (2.0 * tension * math.sin(theta)),
         }
 
-    rows = _solve_levels(system, path, list(tension_levels), measure)
+    rows = _solve_levels(system, load, list(tension_levels), measure)
     return {"kernel": kernel, "footprint": footprint, "steps": rows,
             "wall_time_s": time.perf_counter() - start, "vertices": int(model.vertex_count)}
