@@ -28,7 +28,7 @@ def closed_case(level: str, nodes: int) -> dict:
     """The closed trefoil at L0/D0 = 16.37."""
     scene = closed_trefoil(16.37, nodes=nodes, contact=level)
     t0 = time.perf_counter()
-    res = tie(scene).run()
+    res = tie(scene, tighten_steps=20).run()
     wall = time.perf_counter() - t0
     x = res.system.state.x
     length = float(np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1).sum())

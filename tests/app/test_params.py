@@ -147,19 +147,15 @@ def test_the_scene_defaults_are_the_scenes_own() -> None:
         assert sig["contact"].default == RUN_PARAMS["contact"].default
 
 
-#: tie()'s own defaults that differ from the load path's (its callers that relied on them
-#: pass them, or move to the load path's, when tie() takes its defaults from LoadPath).
-TIE_OWN_DEFAULTS = {"tighten_steps": 20, "pull_steps": 20}
-
-
-def test_the_load_functions_agree_with_the_load_path_or_are_listed() -> None:
+def test_the_load_functions_take_the_load_paths_defaults() -> None:
+    from tightknot.loading.batch import tie_batch
     from tightknot.loading.pull import tie_to_lambda
     from tightknot.loading.tie import tie
 
-    for name, p in inspect.signature(tie).parameters.items():
-        if name in parameters(LoadPath):
-            assert p.default == getattr(LoadPath, name) or \
-                TIE_OWN_DEFAULTS.get(name) == p.default, name
+    for fn in (tie, tie_batch):
+        for name, p in inspect.signature(fn).parameters.items():
+            if name in parameters(LoadPath):
+                assert p.default == getattr(LoadPath, name), (fn.__name__, name)
     sig = inspect.signature(tie_to_lambda).parameters
     assert sig["tolerance"].default == LoadPath.lambda_tolerance
     assert sig["residual_tol"].default == LoadPath.residual_tol

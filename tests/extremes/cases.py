@@ -182,6 +182,7 @@ def run_tie_case(name: str, make_scene: Callable[[], KnotScene], summary: bool =
 def slenderness(l0_over_d0: float, nodes: int, closed: bool = True, **tie_kw: Any) -> Outcome:
     """A trefoil of rest length L0 = ``l0_over_d0`` D0 (closed, or open with its tails)."""
     name = f"slenderness L0/D0={l0_over_d0:g} {'closed' if closed else 'open'} N={nodes}"
+    tie_kw = {"tighten_steps": 20, **tie_kw}  # the suite's cases were set up with 20
     if closed:
         return run_tie_case(name, lambda: closed_trefoil(l0_over_d0, D0, nodes), **tie_kw)
     return run_tie_case(name, lambda: open_trefoil(l0_over_d0 * D0, D0, nodes), **tie_kw)

@@ -37,13 +37,13 @@ def newton_correction(system) -> float:  # noqa: ANN001
 
 def test_batch_agrees_with_one_by_one():
     scenes = [closed_trefoil(l0_over_d0=r, nodes=NODES) for r in RATIOS]
-    batch = tie_batch(scenes)
+    batch = tie_batch(scenes, tighten_steps=20)
     assert batch.converged, batch.failure
     assert batch.knot_types == ["3_1"] * len(RATIOS)
     singles = []
     for k, (r, x_b) in enumerate(zip(RATIOS, batch.positions, strict=True)):
         scene = closed_trefoil(l0_over_d0=r, nodes=NODES)
-        single = tie(scene).run()
+        single = tie(scene, tighten_steps=20).run()
         assert single.converged, single.failure
         singles.append(single)
         # Each rod's own system evaluates on its own (its scene's contact layer).
@@ -68,7 +68,7 @@ def test_batch_agrees_with_one_by_one():
 
 def test_copies_never_touch_each_other():
     scenes = [closed_trefoil(l0_over_d0=17.0, nodes=NODES) for _ in range(2)]
-    batch = tie_batch(scenes)
+    batch = tie_batch(scenes, tighten_steps=20)
     assert batch.converged, batch.failure
     # All candidate pairs of the joint model at the result: none joins two copies.
     joint = build_batch(scenes)
@@ -90,7 +90,7 @@ def test_joint_evaluation_equals_one_rod():
     """Energy parts, gradient and Hessian of a tight knot, asked of the batch evaluator,
     equal those of its own RodSystem (contact included)."""
     scene = closed_trefoil(l0_over_d0=17.0, nodes=NODES)
-    single = tie(scene).run().system
+    single = tie(scene, tighten_steps=20).run().system
     st = single.state
     scenes = [closed_trefoil(l0_over_d0=r, nodes=NODES) for r in (17.0, 19.0)]
     joint = build_batch(scenes)
@@ -163,7 +163,7 @@ def test_single_blas_thread_restores_the_thread_counts():
 
 def test_a_failed_rod_is_named():
     scenes = [closed_trefoil(l0_over_d0=20.0, nodes=NODES)]
-    batch = tie_batch(scenes, relax_iterations=2)
+    batch = tie_batch(scenes, tighten_steps=20, relax_iterations=2)
     assert not batch.converged
     assert batch.failure.startswith("rod 0 (closed_trefoil, L0/D0 20)")
     assert "relax: Newton max_iterations" in batch.failure

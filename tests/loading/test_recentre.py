@@ -77,7 +77,7 @@ def test_a_perturbed_start_still_reaches_lambda_15(seed: int) -> None:
     scene = open_trefoil(rest_length=0.185, nodes=150)
     rng = np.random.default_rng(seed)
     scene.state.x = scene.state.x + 1e-9 * scene.diameter * rng.normal(size=scene.state.x.shape)
-    res = tie(scene, pull_force=1.8).run()
+    res = tie(scene, pull_force=1.8, tighten_steps=20, pull_steps=20).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     x = res.system.state.x

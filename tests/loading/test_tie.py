@@ -112,7 +112,7 @@ def test_a_hard_pull_keeps_the_knot_and_its_tube(contact: str) -> None:
         return sc
 
     first = make()
-    tight = tie(first).run()
+    tight = tie(first, tighten_steps=20).run()
     assert tight.converged, tight.failure
     f_t = end_reaction(tight.system)
     scene = make()
@@ -122,7 +122,7 @@ def test_a_hard_pull_keeps_the_knot_and_its_tube(contact: str) -> None:
         if phase == "pull":
             gaps.append(scene.contact.min_distance(system.state.x)[0] / scene.diameter)
 
-    res = tie(scene, pull_force=3.0 * f_t, hook=hook).run()
+    res = tie(scene, pull_force=3.0 * f_t, hook=hook, tighten_steps=20, pull_steps=20).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     assert len(gaps) >= 5

@@ -99,10 +99,10 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
               for r in ratios]
     # Warm up both paths on one small case (kernel modules loaded, tables cached), so that
     # neither pays a one-time cost inside its timing.
-    tie(closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device)).run()
-    tie_batch([closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device)])
+    tie(closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device), tighten_steps=20).run()
+    tie_batch([closed_trefoil(l0_over_d0=lo, nodes=nodes, device=device)], tighten_steps=20)
     t0 = time.perf_counter()
-    batch = tie_batch(scenes, residual_tol=residual_tol)
+    batch = tie_batch(scenes, tighten_steps=20, residual_tol=residual_tol)
     tb = time.perf_counter() - t0
     if not batch.converged:
         raise RuntimeError(f"batched tie failed: {batch.failure}")
@@ -119,7 +119,7 @@ def run(rods: int = 64, nodes: int = 100, l0_over_d0: tuple[float, float] = (17.
         for k in pick:
             scene = closed_trefoil(l0_over_d0=float(ratios[k]), nodes=nodes, device=device)
             t0 = time.perf_counter()
-            single = tie(scene, residual_tol=residual_tol).run()
+            single = tie(scene, tighten_steps=20, residual_tol=residual_tol).run()
             ts += time.perf_counter() - t0
             if not single.converged:
                 raise RuntimeError(f"sequential tie of case {k} failed: {single.failure}")

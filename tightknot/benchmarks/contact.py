@@ -114,7 +114,7 @@ def run(vertices: int = 300, repeats: int = 30, device: str = "cpu") -> dict:
         raise ValueError(f"vertices must be >= 60 (a trefoil of 125 mm), got {vertices}")
     scene = open_trefoil(SCENE["rest_length_m"], nodes=vertices, device=device)
     t0 = time.perf_counter()
-    res = tie(scene, pull_force=SCENE["pull_force_N"]).run()
+    res = tie(scene, pull_force=SCENE["pull_force_N"], tighten_steps=20, pull_steps=20).run()
     tie_s = time.perf_counter() - t0
     if not res.converged:
         raise RuntimeError(f"the benchmark scene did not converge: {res.failure}")

@@ -59,7 +59,7 @@ def closed_case(nodes: int = 200, device: str = "cpu") -> dict:
     iterations."""
     scene = closed_trefoil(16.37, nodes=nodes, device=device)
     t0, c0 = time.perf_counter(), time.process_time()
-    res = tie(scene).run()
+    res = tie(scene, tighten_steps=20).run()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     x = res.system.state.x
     return {"case": "closed_trefoil", "vertices": nodes, "l0_over_d0": 16.37,

@@ -126,7 +126,7 @@ def tightknot_row(vertices: int = VERTICES, end_distance: float = END_DISTANCE,
 
     w0, c0 = time.perf_counter(), time.process_time()
     scene = open_trefoil(rest_length, nodes=int(vertices))
-    res = tie(scene, end_distance=end_distance).run()
+    res = tie(scene, end_distance=end_distance, tighten_steps=20, pull_steps=20).run()
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
     x = res.system.state.x.copy()
     row = {"code": "tightknot", "wall_time_s": wall, "cpu_time_s": cpu,

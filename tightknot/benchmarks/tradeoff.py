@@ -102,9 +102,9 @@ def run_case(knot: str, nodes: int, level: Level, residual_tol: float,
 
     t0 = time.perf_counter()
     scene = _scene(knot, nodes, level)
-    opts: dict = {"residual_tol": residual_tol}
+    opts: dict = {"residual_tol": residual_tol, "tighten_steps": 20}
     if not scene.closed:
-        opts["pull_force"] = OPEN_PULL_FORCE_N
+        opts.update(pull_force=OPEN_PULL_FORCE_N, pull_steps=20)
 
     def watch(*_args: object) -> None:
         if time.perf_counter() - t0 > budget_s:

@@ -36,6 +36,7 @@ import numpy as np
 
 from tightknot.contact.layer import ContactLayer, ContactSettings
 from tightknot.knots.scenes import KnotScene, gauge
+from tightknot.loading.options import LoadPath
 from tightknot.loading.tie import TieResult, knot_type_of, tie
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.model import Model
@@ -227,9 +228,9 @@ def _tie_program(k: int, scene: KnotScene, evaluator: BatchEvaluator, tighten_st
 
 def tie_batch(
     scenes: list[KnotScene],
-    tighten_steps: int = 20,
-    residual_tol: float = 1e-6,
-    relax_iterations: int = 2000,
+    tighten_steps: int = LoadPath.tighten_steps,
+    residual_tol: float = LoadPath.residual_tol,
+    relax_iterations: int = LoadPath.relax_iterations,
 ) -> BatchResult:
     """Tie closed knots together, each along its own path as :func:`tightknot.loading.tie.tie`
     would (relax the start curve, then shrink the rest length from the start length to L0

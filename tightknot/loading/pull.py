@@ -15,6 +15,7 @@ from tightknot.knots.scenes import (
     vertex_radii,
 )
 from tightknot.loading.levels import Check, LevelLoad, LevelOptions, LevelPath, SearchOptions
+from tightknot.loading.options import LoadPath
 from tightknot.loading.recentre import recentre_system
 from tightknot.loading.tie import StepHook, TieResult, end_reaction, knot_type_of, tie
 from tightknot.solvers.continuation import StepRecord
@@ -76,7 +77,7 @@ def tie_to_lambda(
     tolerance: float = 0.1,
     force_ratio: float = 1.15,
     max_force_steps: int = 60,
-    residual_tol: float = 1e-6,
+    residual_tol: float = LoadPath.residual_tol,
     hook: StepHook | None = None,
 ) -> Program[TieResult]:
     """Tie an open knot, then pull until Lambda_OC = ``target`` within ``tolerance``; a

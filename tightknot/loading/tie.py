@@ -35,6 +35,7 @@ from tightknot.knots.scenes import (
     gauge,
 )
 from tightknot.loading.diagnose import topology_change
+from tightknot.loading.options import LoadPath
 from tightknot.loading.recentre import recentre_system
 from tightknot.rods.state import State
 from tightknot.solvers.continuation import (
@@ -125,11 +126,11 @@ def tie(
     scene: KnotScene,
     pull_force: float | None = None,
     end_distance: float | None = None,
-    tighten_steps: int = 20,
-    pull_steps: int = 20,
-    residual_tol: float = 1e-6,
+    tighten_steps: int = LoadPath.tighten_steps,
+    pull_steps: int = LoadPath.pull_steps,
+    residual_tol: float = LoadPath.residual_tol,
     hold_force_scale: float = 0.05,
-    relax_iterations: int = 2000,
+    relax_iterations: int = LoadPath.relax_iterations,
     hook: StepHook | None = None,
     attach: Callable[[RodSystem], None] | None = None,
     start_state: State | None = None,
