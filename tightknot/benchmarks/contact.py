@@ -25,10 +25,6 @@ of the Newton iterations and their line searches) over the rest of the solve, a 
 the piecewise ratio on a whole solve (line searches evaluate energies without Hessians, so
 the two differ).
 
-Until version 0.3 of this benchmark the pieces were timed on a system without the pulling
-force, whose "Newton step" was a 0.34 m jump of the free end: the step bound then swept
-every edge across the knot (14 000 candidate pairs) and cost 1.2 ms instead of a real
-step's.
 """
 
 from __future__ import annotations

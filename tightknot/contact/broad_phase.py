@@ -3,7 +3,8 @@
 A Warp BVH over the edges' bounds (swept by a step, inflated by a margin), rebuilt at every
 query; candidate edge pairs go to a fixed-capacity buffer that grows (and the query reruns)
 when it overflows, so no contact is ever dropped. Pairs closer along the rod than the
-exclusion window are skipped (measured on the rest arcs, which change with the load path).
+exclusion window are skipped, measured on the rest arcs scaled by :attr:`BroadPhase.
+window_scale` (the window follows the stretched rod, set at every load step).
 The bounds are float32 (Warp's BVH), padded so that their rounding never shrinks them.
 """
 

@@ -31,9 +31,6 @@ reproduce them at every overlap:
   (2 pi/sin phi) int_d^R psi(t) t dt``, so with a pair weight sin(phi)
   ``psi_p(rho) = K m (R - rho)^(m-1)/(2 pi rho)``.
 
-(A first version used powers of x = (R^2 - rho^2)/(2R) whose integrals are exact powers of
-x, not of delta: its force was the law's times d/R and vanished at full overlap, which let
-tight knots collapse; measured 13 % of the law at d = 0.13 D.)
 
 The two are blended by crossing angle (Meier, Popp, Wall 2016, "A unified approach for
 beam-to-beam contact", CMAME 315:972: line contact below ``angle_line``, point contact above
@@ -43,9 +40,8 @@ touch and exactly zero while d >= R; past the band the kernels act at delta - b 
 of 1e-4 R: 3 % of the force at the smallest overlap the FEM cross-check uses, 0.003 D).
 
 Resolution: the contact zone of a pair at overlap x has half-length sqrt(2 R x) along the
-strands; the Gauss quadrature reproduces the laws within 1 to 3 % when it spans two Gauss
-spacings or more (measured with 2 points on edges of D/4: 2 % at x >= 0.05 D, 5 % at
-x = 0.01 D).
+strands; the Gauss quadrature reproduces the laws within a few per cent when it spans two
+Gauss spacings or more (docs/design_notes.md, contact).
 """
 
 from __future__ import annotations
@@ -327,8 +323,8 @@ def _kernel_table(kind: str, m: float, band: float = TABLE_BAND) -> np.ndarray:
 
     u = np.linspace(U_MIN, 1.0, TABLE_INTERVALS + 1)
     # The band lies inside the contact, [0, 2 band] in 1 - u: T(1) = 0 exactly, with zero
-    # derivatives, so first touch is continuous (a centred band made T(1) = 3 band/16 > 0,
-    # an energy jump as a Gauss pair crossed u = 1: measured, it stalled Newton).
+    # derivatives, so first touch is continuous (a centred band would give T(1) > 0: an
+    # energy jump as a Gauss pair crosses u = 1, which stalls Newton).
     ue = 1.0 - _ramp(1.0 - u - band, band)
     if kind == "line":
         vals = abel_line_profile(m, ue)

@@ -25,9 +25,7 @@ G_e = sum of E_R over the pairs holding e):
 
 The Hessian couples every vertex of the window of a with every vertex of the window of b
 (about 78 x 78 entries per pair at 1 D0 and 12 edges per D0): Newton keeps its quadratic
-convergence (measured: the study's three knots tie in 320, 861 and 821 iterations against
-327, 842 and 801 with the edge's own stretch), at 1.7 to 2.6 times the time
-(bench/contact_levels.py).
+convergence, at about twice the time (bench/contact_levels.py, docs/design_notes.md).
 """
 
 from __future__ import annotations

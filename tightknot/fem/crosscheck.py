@@ -43,11 +43,9 @@ moved toward the cylinder by the same stretched radius (FEM keys ``*_nominal``,
 :func:`tightknot.fem.scenes.wrap.nominal_axis`); curvature and line load per length are
 taken on it. The section CENTROID is not that point: the flattening at the contact moves
 it away from the cylinder, most at the middle where the load peaks, which bends the
-centroid line by more than the axis. Measured on the coarse mesh, tension 0.0069 E D0^2:
-centroid kappa D0 = 0.505, nominal 0.184, rod model 0.188 (the near fibre follows the
-cylinder, kappa D0 = 2.0); and the approach of the nominal axis matches the rod model's
-within 0.02 D0 at every level (0.042/0.038 ... 0.276/0.278), the centroid's does not
-(0.036 ... 0.212). The centroid-axis values are reported too (``centroid_axis``).
+centroid line by more than the axis, and the nominal axis's approach is the rod model's
+while the centroid's is not (docs/design_notes.md, FEM cross-check). The centroid-axis values
+are reported too (``centroid_axis``).
 
 Approach (the gate of the compared levels). indent: the total approach 2 w of the two
 indenters; wrap: D0 - d, d the distance from the mid section's centroid to the cylinder

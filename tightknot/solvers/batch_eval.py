@@ -350,9 +350,9 @@ class BatchEvaluator:
         :meth:`tightknot.solvers.system.RodSystem.compact_pattern`)."""
         r = self.rods[k]
         keep = np.unique(self._local_blocks(k, self._touching[k]))
-        # Rebuilding a pattern costs about 2 ms (the same for one rod alone); stale blocks
-        # only cost fill in the factorization, so the pattern is rebuilt when at least a
-        # quarter of its blocks went stale, not at every load step.
+        # Rebuilding a pattern costs more than the fill of a few stale blocks in the
+        # factorization, so the pattern is rebuilt when at least a quarter of its blocks
+        # went stale, not at every load step.
         if keep.size >= 0.75 * r.cpattern.block_keys.size:
             return
         r.cpattern.reset(keep)
