@@ -270,3 +270,21 @@ def test_report_of_a_rigid_tube_and_of_free_rods() -> None:
     far = two_rods(0.0, 2.0 * D)
     rep2 = contact_report(ContactLayer(far, LAW), far.vertex_initial_position)
     assert not rep2.overlap.any() and np.allclose(rep2.area_ratio, 1.0)
+
+
+def test_a_coarse_straight_rod_reports_no_contact_with_its_neighbours() -> None:
+    # Edges of 0.393 D (the 1 m rod at 300 vertices): edges three apart hold points farther
+    # apart along the rod than the window (pi D / 2) though their nearest ends are only
+    # 0.78 D apart; their whole segments' distance would read as an overlap. Only the
+    # points beyond the window count, and a straight rod touches nothing.
+    from tightknot.contact.report import contact_report
+
+    n = 61
+    x = np.c_[np.linspace(0.0, 60 * 0.393 * D, n), np.zeros(n), np.zeros(n)]
+    b = RodBuilder(twist=False)
+    b.add_rod(x, D, Material(1e6, 0.5, 1000.0))
+    m = b.finalize()
+    layer = ContactLayer(m)
+    assert len(layer.nonlocal_pairs(x, m.edge_rest_length)) > 0  # the straddling pairs
+    rep = contact_report(layer, x, m.edge_rest_length)
+    assert np.all(rep.contact_width_fraction == 0.0) and np.all(rep.overlap == 0.0)

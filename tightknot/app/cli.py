@@ -155,8 +155,8 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     if not args.quiet:
         keys = ("knot_type", "converged", "load_steps", "stretch", "L_over_D", "lambda_oc",
                 "pull_force_N", "min_gap_over_D0", "min_area_ratio",
-                "max_contact_width_fraction", "max_pressure_over_E", "newton_iterations",
-                "wall_time_s")
+                "max_contact_width_fraction", "max_pressure_over_E", "max_approach_w_over_D0",
+                "calibrated_w_over_D0", "newton_iterations", "wall_time_s")
         for k in keys:
             if k in summary:
                 print(f"  {k:28s} {summary[k]}")
@@ -165,6 +165,8 @@ def _cmd_tie(args: argparse.Namespace) -> int:
             if outs.folder not in path.parents:
                 print(f"wrote {path}")
         print(f"look at it: tightknot view {outs.rrd}")
+    for warning in summary.get("warnings", []):
+        print(f"tightknot tie: warning: {warning}", file=sys.stderr)
     if not run.result.converged:
         print(f"tightknot tie: failed: {run.result.failure} (after {summary['load_steps']} "
               f"converged load steps; the final state is the last step of {outs.rrd})",

@@ -68,22 +68,24 @@ class ContactChecks:
                 f"{d[k]:.4g} m apart, below the hard limit {hard[k]:.4g} m "
                 f"({self.hard_fraction:g} D)")
 
-    def beyond_window(self, x: np.ndarray, pr: np.ndarray, d: np.ndarray, ar: np.ndarray,
-                      grid: int = 17) -> np.ndarray:
-        """Distances [m] of pairs of one rod that straddle the exclusion window, measured
-        only between their points farther apart along the rod than the window (on a
-        ``grid`` x ``grid`` set of point pairs): the whole segments' distance would be that
-        of a tight bend's neighbouring points on a coarse mesh. Other pairs keep ``d``."""
+    def window_closest(self, x: np.ndarray, pr: np.ndarray, ar: np.ndarray,
+                       grid: int = 17) -> tuple[np.ndarray, ...]:
+        """For the pairs of one rod that straddle the exclusion window: their indices in
+        ``pr``, and the distance [m] and parameters (s, t) on the two edges of their closest
+        point pair among those farther apart along the rod than the window (on a ``grid``
+        x ``grid`` set of point pairs; inf and 0.5 where none is): the whole segments'
+        closest points would be those of a tight bend's neighbouring points on a coarse
+        mesh. ``ar``: the arcs the window is judged by (:meth:`BroadPhase.arcs`)."""
         m = self.broad.model
         same, seps, length, closed, excl = self.broad.window_separations(pr, ar)
         a, b = ar[pr[:, 0]], ar[pr[:, 1]]
         partial = np.flatnonzero(same & (seps.min(axis=1) < excl))
-        if not partial.size:
-            return d
-        d = d.copy()
+        d = np.full(partial.size, math.inf)
+        s = np.full(partial.size, 0.5)
+        tt = np.full(partial.size, 0.5)
         u = np.linspace(0.0, 1.0, grid)
         ev = m.edge_vertex
-        for k in partial:
+        for i, k in enumerate(partial):
             ea, eb = pr[k]
             pa = x[ev[ea, 0]] + u[:, None] * (x[ev[ea, 1]] - x[ev[ea, 0]])
             pb = x[ev[eb, 0]] + u[:, None] * (x[ev[eb, 1]] - x[ev[eb, 0]])
@@ -92,9 +94,23 @@ class ContactChecks:
             sep = np.abs(sa[:, None] - sb[None, :])
             if closed[k]:
                 sep = np.minimum(sep, length[k] - sep)
-            dist = np.linalg.norm(pa[:, None, :] - pb[None, :, :], axis=2)
-            ok = sep >= excl[k]
-            d[k] = dist[ok].min() if ok.any() else math.inf
+            dist = np.where(sep >= excl[k], np.linalg.norm(pa[:, None, :] - pb[None, :, :],
+                                                            axis=2), math.inf)
+            j = int(np.argmin(dist))
+            d[i] = dist.flat[j]
+            s[i], tt[i] = u[j // grid], u[j % grid]
+        return partial, d, s, tt
+
+    def beyond_window(self, x: np.ndarray, pr: np.ndarray, d: np.ndarray, ar: np.ndarray,
+                      grid: int = 17) -> np.ndarray:
+        """Distances ``d`` [m] of pairs ``pr``, those of the pairs straddling the exclusion
+        window measured only between their points farther apart along the rod than the
+        window (:meth:`window_closest`)."""
+        partial, dp, _, _ = self.window_closest(x, pr, ar, grid)
+        if not partial.size:
+            return d
+        d = d.copy()
+        d[partial] = dp
         return d
 
     def min_distance(self, x: np.ndarray, rest: np.ndarray) -> tuple[float, int, int]:

@@ -89,6 +89,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
     radius_e = m.edge_radius * stretch_e ** (-nu)
     d0 = 2.0 * m.edge_radius
     pairs = layer.nonlocal_pairs(x, rest)  # not the pairs only the local barrier sees
+    arcs = layer.broad_phase.arcs(rest)[0].numpy()
     w1 = np.zeros(m.edge_count)
     n1 = np.zeros((m.edge_count, 3))
     w2 = np.zeros(m.edge_count)
@@ -97,6 +98,11 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
     if pairs.shape[0]:
         a, b = pairs[:, 0], pairs[:, 1]
         s, t = _segment_closest(x[ev[a, 0]], x[ev[a, 1]], x[ev[b, 0]], x[ev[b, 1]])
+        # A pair straddling the exclusion window touches only through its points farther
+        # apart along the rod than the window (on a coarse rod, whole segments a few edges
+        # apart would read as a contact of neighbours).
+        partial, _, sp, tp = layer.checks.window_closest(x, pairs, arcs)
+        s[partial], t[partial] = sp, tp
         pa = x[ev[a, 0]] + s[:, None] * e[a]
         pb = x[ev[b, 0]] + t[:, None] * e[b]
         dvec = pb - pa

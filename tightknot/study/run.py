@@ -167,6 +167,7 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         "contact_sigma": np.asarray(rep["contact_sigma"]).tolist(),
         "centerline_m": x.tolist(),
     }
+    out.update(calibration_range(scene, contact))
     if scene.closed:
         out["rho"] = np.asarray(rep["rho"]).tolist()
         out["z"] = np.asarray(rep["z"]).tolist()
@@ -175,6 +176,29 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         out["lambda_oc"] = None if lam is None or not np.isfinite(lam) else float(lam)
         out["pull_force_N"] = float(res.pull_force_N)
     return out
+
+
+def calibration_range(scene: KnotScene, contact: ContactReport) -> dict[str, Any]:
+    """Where the state stands against the range its contact law was calibrated in: the
+    largest per-side approach w/D0 of its contacts (half the pair overlap), the law's
+    calibrated limit, and a warning for each way the run leaves it (a deeper squeeze, whose
+    force is then extrapolated; a rod that is not incompressible, nu != 0.5, while the law
+    was calibrated on an incompressible solid)."""
+    law = scene.contact.law
+    w_hat = 0.5 * float(np.max(contact.overlap, initial=0.0)) / scene.diameter
+    warnings = []
+    if not law.rigid:
+        if w_hat > law.calibrated_w_hat:
+            warnings.append(f"the contact reaches a per-side approach w/D0 = {w_hat:.3g}, "
+                            f"beyond the {law.calibrated_w_hat:.3g} the law was calibrated to "
+                            "(its force there is extrapolated)")
+        nus = {r.material.poisson_ratio for r in scene.model.rods}
+        if any(abs(nu - 0.5) > 1e-12 for nu in nus):
+            warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "
+                            "calibrated on an incompressible solid (nu = 0.5): extrapolated")
+    return {"max_approach_w_over_D0": w_hat,
+            "calibrated_w_over_D0": None if law.rigid else law.calibrated_w_hat,
+            "outside_calibrated_range": bool(warnings), "warnings": warnings}
 
 
 def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
