@@ -247,8 +247,11 @@ def test_tie_flags_override_the_config_file(tmp_path) -> None:
     forced = resolved("--config", str(cfg), "--force", "3")
     assert forced.force == 3.0 and forced.target_lambda is None and forced.length == 0.125
     # Another knot drops the file's knot-specific values (its nodes, length and load).
+    from tightknot.knots.scenes import default_nodes
+
     closed = resolved("closed", "--config", str(cfg))
-    assert closed.knot == "closed" and closed.nodes == 200 and closed.length is None
+    assert closed.knot == "closed" and closed.length is None
+    assert closed.nodes == default_nodes(closed.l0_over_d0, True)  # from its own length
     assert closed.youngs_modulus == 2e6
 
 

@@ -12,13 +12,15 @@ from tightknot.app.config import (
     config_keys,
     load_config,
 )
+from tightknot.knots.scenes import default_nodes
 
 
 def test_defaults_are_resolved() -> None:
     c = config_from_dict({"knot": "closed"})
-    assert c.nodes == 200 and c.l0_over_d0 == 16.37 and c.length is None
+    # The vertex count follows the rest length: one vertex per DEFAULT_EDGE_D0 D0.
+    assert c.nodes == default_nodes(16.37, True) and c.l0_over_d0 == 16.37 and c.length is None
     o = config_from_dict({"knot": "open", "force": 5})
-    assert o.nodes == 300 and o.length == 0.185 and o.force == 5.0
+    assert o.nodes == default_nodes(0.185 / 8.5e-3, False) and o.length == 0.185 and o.force == 5.0
     assert isinstance(o.force, float)  # an int in the file is a number of newtons
 
 

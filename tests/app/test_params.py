@@ -12,6 +12,7 @@ import pytest
 
 from tightknot.app.cli import build_parser, tie_config
 from tightknot.app.config import config_from_dict, config_keys
+from tightknot.knots.scenes import default_nodes
 from tightknot.loading.options import LoadPath, Range, flag, parameters
 from tightknot.study.params import (
     CONTACT_LEVELS,
@@ -20,6 +21,7 @@ from tightknot.study.params import (
     KNOTS,
     RUN_PARAMS,
     Scene,
+    resolve_nodes,
 )
 from tightknot.sweep.cases import CASE_KEYS, LEVELS, NOT_CASE_KEYS, canonical, defaults
 
@@ -99,6 +101,9 @@ def test_config_and_sweep_resolve_the_same_defaults(knot: str, knot_type: str) -
     case = defaults(knot, knot_type)
     assert {k: cfg[k] for k in case} == case
     for k, v in case.items():
+        if k == "nodes":  # from the rest length
+            assert v == resolve_nodes({"knot": knot, **case}), k
+            continue
         assert v == KNOT_DEFAULTS[(knot, knot_type)].get(k, RUN_PARAMS[k].default) or \
             k == "knot_type", k
 
@@ -143,7 +148,8 @@ def test_the_scene_defaults_are_the_scenes_own() -> None:
         sig = inspect.signature(getattr(scenes, f"{knot}_{names[knot_type]}")).parameters
         length = sig["l0_over_d0" if knot == "closed" else "rest_length"].default
         assert table["l0_over_d0" if knot == "closed" else "length"] == length
-        assert (table["nodes"], table["twist"]) == (sig["nodes"].default, sig["twist"].default)
+        assert table["twist"] == sig["twist"].default
+        assert sig["nodes"].default is None  # both resolve it from the rest length
         assert sig["contact"].default == RUN_PARAMS["contact"].default
 
 
@@ -185,8 +191,10 @@ def test_a_config_file_for_another_knot_keeps_only_what_carries_over(tmp_path) -
     opened = tie_config(parse(["tie", "open", "--config", str(path), "--force", "2"]))
     # The knot's own values go back to the open knot's defaults; the rest carries over.
     assert (opened.nodes, opened.twist, opened.length, opened.l0_over_d0) == \
-        (300, False, 0.185, None)
+        (default_nodes(0.185 / 8.5e-3, False), False, 0.185, None)
     assert opened.youngs_modulus == 2e6 and opened.force == 2.0
-    # Another knot type of the same knot: only its length changes.
+    # Another knot type of the same knot: its length changes, and the vertex count that
+    # follows the length.
     eight = tie_config(parse(["tie", "--config", str(path), "--knot-type", "4_1"]))
-    assert (eight.nodes, eight.l0_over_d0, eight.youngs_modulus) == (100, 22.1, 2e6)
+    assert (eight.nodes, eight.l0_over_d0, eight.youngs_modulus) == (
+        default_nodes(22.1, True), 22.1, 2e6)

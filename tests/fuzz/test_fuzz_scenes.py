@@ -71,8 +71,6 @@ def test_open_trefoil_parameters(length, d, n, tail) -> None:
 # -- found by fuzzing, fixed: each now gives a ValueError naming the parameter ---------------
 KNOWN_BUGS = [
     # (scene, arguments): the error is not a ValueError, or does not name the parameter.
-    ("closed", dict(nodes=None)),            # TypeError from int(None)
-    ("open", dict(nodes=None)),
     ("closed", dict(nodes=math.inf)),        # OverflowError
     ("closed", dict(nodes=math.nan)),        # ValueError "cannot convert float NaN..."
     ("closed", dict(clearance=0.0)),         # ZeroDivisionError

@@ -29,6 +29,7 @@ from tightknot.study.params import (
     Scene,
     check_scene,
     knot_defaults,
+    resolve_nodes,
 )
 
 __all__ = ["COLOR_ALIASES", "COLOR_FIELDS", "TieConfig", "config_from_dict", "config_keys",
@@ -107,6 +108,8 @@ def config_from_dict(data: dict[str, Any]) -> TieConfig:
     for key, value in knot_defaults(knot, clean.get("knot_type", Scene.knot_type)).items():
         if clean.get(key) is None:
             clean[key] = value
+    if clean.get("nodes") is None:
+        clean["nodes"] = resolve_nodes({"diameter": Scene.diameter, **clean})
     check_scene(clean)
     return TieConfig(**clean)
 
@@ -116,6 +119,8 @@ def knot_specific(old: tuple[str, str], new: tuple[str, str]) -> set[str]:
     ``new``: the per-knot defaults that differ, and on another knot those of one knot only."""
     a, b = KNOT_DEFAULTS[old], KNOT_DEFAULTS[new]
     keys = {k for k in a.keys() | b.keys() if a.get(k) != b.get(k)}
+    if old != new:
+        keys.add("nodes")  # a resolution of the old knot's rod, whose length follows it
     if old[0] != new[0]:
         keys |= {k for k, p in _PARAMS.items() if p.only is not None}
     return keys

@@ -13,7 +13,8 @@ import importlib
 from typing import Any
 
 #: Benchmark modules, in the order ``tightknot bench --help`` lists them.
-BENCHMARKS = ("der", "contact", "knots", "sweep", "batch", "tradeoff", "scaling", "peers")
+BENCHMARKS = ("der", "contact", "knots", "sweep", "batch", "tradeoff", "scaling", "peers",
+              "force_range")
 
 _EXAMPLES = """examples:
   tightknot bench der --json der.json

@@ -92,6 +92,11 @@ GRIP_LENGTH = 1.0
 #: pull axis inside the grip) or "clamped" (its material frame held).
 GRIP_TWIST = ("free", "clamped")
 
+#: Default edge length [D0] of a scene's rod: its vertex count follows its rest length
+#: (:func:`default_nodes`). About the study's loose open trefoil's 300 vertices over 21.8 D0;
+#: the trade-off study (README) gives the accuracy a resolution buys.
+DEFAULT_EDGE_D0 = 0.07
+
 #: Length over diameter of the ideal (tightest rigid-tube) closed knots: trefoil 16.3715
 #: (Przybyl & Pieranski 2014), figure-eight 21.0415 (Ashton, Cantarella, Piatek, Rawdon 2011).
 IDEAL_L_OVER_D = {"3_1": 16.3715, "4_1": 21.0415}
@@ -166,6 +171,13 @@ def _rotate_to_axes(points: np.ndarray, a: int, b: int, c: int) -> np.ndarray:
     ey = v / np.linalg.norm(v)
     ez = np.cross(ex, ey)
     return p @ np.stack([ex, ey, ez], axis=1)
+
+
+def default_nodes(length_over_d0: float, closed: bool) -> int:
+    """Vertices of a rod of rest length ``length_over_d0`` D0 with edges of about
+    :data:`DEFAULT_EDGE_D0` D0 (a closed rod has as many edges as vertices)."""
+    edges = max(1, math.ceil(length_over_d0 / DEFAULT_EDGE_D0 - 1e-9))
+    return edges if closed else edges + 1
 
 
 def _check_common(diameter: float, nodes: int, minimum: int) -> float:
@@ -268,7 +280,7 @@ def _check_ratio(l0_over_d0: float, knot_type: str) -> float:
 def closed_trefoil(
     l0_over_d0: float = 16.37,
     diameter: float = STUDY_DIAMETER,
-    nodes: int = 200,
+    nodes: int | None = None,
     material: Material | None = None,
     law: RadialComplianceLaw | None = None,
     twist: bool = True,
@@ -279,8 +291,9 @@ def closed_trefoil(
     """The study's closed trefoil: rest length L0 = ``l0_over_d0`` D0, joined with no excess
     twist, no external load (physics.md sec. 1, scene 1). ``twist``, ``contact``: model
     levels (module docstring)."""
-    d0 = _check_common(diameter, nodes, 24)
     ratio = _check_ratio(l0_over_d0, "3_1")
+    nodes = default_nodes(ratio, True) if nodes is None else nodes
+    d0 = _check_common(diameter, nodes, 24)
     twist, contact = check_twist(twist), check_contact(contact, law)
     return _closed_knot("closed_trefoil", "3_1", curves.trefoil(4000), ratio, d0, nodes,
                         material, law, twist, contact, device, clearance)
@@ -289,7 +302,7 @@ def closed_trefoil(
 def closed_figure_eight(
     l0_over_d0: float = FIGURE_EIGHT_L0_OVER_D0,
     diameter: float = STUDY_DIAMETER,
-    nodes: int = 200,
+    nodes: int | None = None,
     material: Material | None = None,
     law: RadialComplianceLaw | None = None,
     twist: bool = True,
@@ -301,22 +314,28 @@ def closed_figure_eight(
     :data:`FIGURE_EIGHT_L0_OVER_D0`, 5 % above the ideal 21.04), joined with no excess
     twist, no external load: the trefoil's scene for a second knot type. ``twist``,
     ``contact``: model levels (module docstring)."""
-    d0 = _check_common(diameter, nodes, 32)
     ratio = _check_ratio(l0_over_d0, "4_1")
+    nodes = default_nodes(ratio, True) if nodes is None else nodes
+    d0 = _check_common(diameter, nodes, 32)
     twist, contact = check_twist(twist), check_contact(contact, law)
     return _closed_knot("closed_figure_eight", "4_1", curves.figure_eight(4000), ratio, d0,
                         nodes, material, law, twist, contact, device, clearance)
 
 
 def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter: float,
-               nodes: int, material: Material | None, law: RadialComplianceLaw | None,
-               twist: bool, contact: str, device: str, tail_fraction: float,
+               nodes: int | None, material: Material | None,
+               law: RadialComplianceLaw | None, twist: bool, contact: str, device: str,
+               tail_fraction: float,
                clearance: float, corner_std: float, grip_length: float, grip_twist: str,
                corner_window: float | None = None) -> KnotScene:
     """An open knot with straight tails from ``curve_fn(n, size, tail)`` (a curves.open_*
     helper; module docstring and :func:`open_trefoil`); ``corner_std``: std of the Gaussian
     rounding of the tail corners [knot-size units], applied to the whole curve, or only
-    within ``corner_window`` units of the corners when given."""
+    within ``corner_window`` units of the corners when given; ``nodes`` None: from the
+    rest length (:func:`default_nodes`)."""
+    if nodes is None:
+        nodes = default_nodes(check_positive("rest_length", rest_length, "m")
+                              / check_positive("diameter", diameter, "m"), False)
     d0 = _check_common(diameter, nodes, 40)
     twist, contact = check_twist(twist), check_contact(contact, law)
     l0 = check_positive("rest_length", rest_length, "m")
@@ -392,7 +411,7 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
 def open_trefoil(
     rest_length: float = 0.185,
     diameter: float = STUDY_DIAMETER,
-    nodes: int = 300,
+    nodes: int | None = None,
     material: Material | None = None,
     law: RadialComplianceLaw | None = None,
     twist: bool = False,
@@ -420,7 +439,7 @@ def open_trefoil(
 def open_figure_eight(
     rest_length: float = 0.30,
     diameter: float = STUDY_DIAMETER,
-    nodes: int = 300,
+    nodes: int | None = None,
     material: Material | None = None,
     law: RadialComplianceLaw | None = None,
     twist: bool = False,

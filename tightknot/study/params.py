@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from tightknot.knots.scenes import DEFAULT_EDGE_D0, default_nodes
 from tightknot.loading.options import LoadPath, Range, format_value, param, parameters
 from tightknot.viz.rerun_log import ROD_FIELDS
 
@@ -31,14 +32,15 @@ SCENE_NAMES = {"3_1": "trefoil", "4_1": "figure_eight"}
 #: Contact levels that can tie a knot (tightknot.knots.scenes.CONTACT_LEVELS less "off").
 CONTACT_LEVELS = ("compliant", "smoothed", "rigid")
 
-#: Defaults that depend on the knot, (knot, knot_type) -> {key: value}: the study's trefoils
+#: Defaults that depend on the knot, (knot, knot_type) -> {key: value} (the vertex count
+#: follows the rest length: :func:`resolve_nodes`): the study's trefoils
 #: (L0/D0 = 16.37; L0 = 185 mm) and the figure-eight scenes' own lengths; twist off for
 #: open knots (an isotropic rod with twist-free ends relaxes its twist to zero).
 KNOT_DEFAULTS: Mapping[tuple[str, str], Mapping[str, Any]] = types.MappingProxyType({
-    ("closed", "3_1"): {"l0_over_d0": 16.37, "nodes": 200, "twist": True},
-    ("closed", "4_1"): {"l0_over_d0": 22.1, "nodes": 200, "twist": True},
-    ("open", "3_1"): {"length": 0.185, "nodes": 300, "twist": False},
-    ("open", "4_1"): {"length": 0.30, "nodes": 300, "twist": False},
+    ("closed", "3_1"): {"l0_over_d0": 16.37, "twist": True},
+    ("closed", "4_1"): {"l0_over_d0": 22.1, "twist": True},
+    ("open", "3_1"): {"length": 0.185, "twist": False},
+    ("open", "4_1"): {"length": 0.30, "twist": False},
 })
 #: Fewest vertices of a knot's scene (tightknot.knots.scenes refuses fewer).
 MIN_NODES = {"closed": 24, "open": 40}
@@ -84,7 +86,7 @@ class Scene:
                                  "rest length L0", only="open",
                                  default_text=_knot_default_text("length"), metavar="L0")
     nodes: int | None = param(None, Range(24, 200_000), "", "vertices of the rod",
-                              default_text=_knot_default_text("nodes"))
+                              default_text=f"one per {DEFAULT_EDGE_D0:g} D0 of rest length")
     diameter: float = param(8.5e-3, Range(0.0, 1.0, low_open=True), "m", "rest diameter D0",
                             metavar="D0")
     youngs_modulus: float = param(1.25e6, Range(0.0, 1e12, low_open=True), "Pa",
@@ -126,6 +128,15 @@ RUN_PARAMS = types.MappingProxyType({**parameters(Scene), **parameters(LoadPath)
 def knot_defaults(knot: str, knot_type: str = "3_1") -> dict[str, Any]:
     """The defaults of ``knot`` ("closed"/"open") of ``knot_type`` that depend on it."""
     return dict(KNOT_DEFAULTS[(knot, knot_type)])
+
+
+def resolve_nodes(values: Mapping[str, Any]) -> int:
+    """The vertex count of a scene whose ``nodes`` is not given: from its rest length
+    (:func:`tightknot.knots.scenes.default_nodes`; ``values``: the resolved scene)."""
+    closed = values["knot"] == "closed"
+    length_over_d0 = (values["l0_over_d0"] if closed
+                      else values["length"] / values.get("diameter", Scene.diameter))
+    return default_nodes(length_over_d0, closed)
 
 
 def check_scene(values: Mapping[str, Any]) -> None:

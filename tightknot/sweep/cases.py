@@ -25,7 +25,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from tightknot.study.params import RUN_PARAMS, check_scene, knot_defaults
+from tightknot.study.params import RUN_PARAMS, check_scene, knot_defaults, resolve_nodes
 
 #: Prefix of the hashed text: bump it when the meaning of a parameter changes, so that a
 #: store written by an older version is not taken for finished work.
@@ -54,7 +54,9 @@ LEVEL_KEYS = tuple(LEVELS)
 def defaults(knot: str, knot_type: str = "3_1") -> dict[str, Any]:
     """Every parameter's default for a ``knot`` ("closed"/"open") of ``knot_type``."""
     per_knot = {"knot_type": knot_type, **knot_defaults(knot, knot_type)}
-    return {k: per_knot[k] if k in per_knot else RUN_PARAMS[k].default for k in CASE_KEYS[knot]}
+    out = {k: per_knot[k] if k in per_knot else RUN_PARAMS[k].default for k in CASE_KEYS[knot]}
+    out["nodes"] = resolve_nodes({"knot": knot, **out})
+    return out
 
 
 def _value(key: str, value: Any) -> Any:
@@ -105,7 +107,14 @@ def canonical(params: Mapping[str, Any]) -> dict[str, Any]:
     knot_type = _value("knot_type", p.get("knot_type", RUN_PARAMS["knot_type"].default))
     out: dict[str, Any] = {"knot": knot}
     for key, default in defaults(knot, knot_type).items():
+        if key == "nodes" and p.get(key) is None:
+            continue  # from the rest length, once that is known
         out[key] = _value(key, p.get(key, default))
+    if "nodes" not in out:
+        # The key keeps its place in the canonical dict's order.
+        resolved = _value("nodes", resolve_nodes(out))
+        out = {k: (resolved if k == "nodes" else out[k]) for k in ["knot", *CASE_KEYS[knot]]
+               if k in out or k == "nodes"}
     check_scene(out)
     if knot == "closed":
         return out
