@@ -288,3 +288,29 @@ def test_a_coarse_straight_rod_reports_no_contact_with_its_neighbours() -> None:
     assert len(layer.nonlocal_pairs(x, m.edge_rest_length)) > 0  # the straddling pairs
     rep = contact_report(layer, x, m.edge_rest_length)
     assert np.all(rep.contact_width_fraction == 0.0) and np.all(rep.overlap == 0.0)
+
+
+def test_the_step_bound_guards_a_pair_inside_the_exclusion_window() -> None:
+    # A hairpin whose legs are 1.2 D apart along the rod (inside the pi/2 D window, where
+    # the energy takes no notice of them) and 0.3 D apart in space; a step moves one leg
+    # through the other. The step bound cuts it so that the legs stay at least their floor
+    # (a quarter of the tightest legal bend's chord, here the hard limit) apart.
+    from tightknot.contact.step_bound import LOCAL_FRACTION
+    from tightknot.rods.proximity import ProximityCheck
+
+    h = 0.1 * D
+    leg = np.arange(7) * h
+    x = np.vstack([np.c_[leg, np.zeros(7), np.zeros(7)],
+                   np.c_[leg[::-1][1:], np.full(6, 0.3 * D), np.zeros(6)]])
+    b = RodBuilder(twist=False)
+    b.add_rod(x, D, Material(1e6, 0.5, 1000.0))
+    m = b.finalize()
+    layer = ContactLayer(m)
+    rest = m.edge_rest_length
+    dx = np.zeros_like(x)
+    dx[7:, 1] = -0.6 * D  # the second leg through the first
+    alpha = layer.max_step(x, dx, rest)
+    assert 0.0 < alpha < 0.5
+    check = ProximityCheck(m, hard_fraction=0.05, local_fraction=LOCAL_FRACTION)
+    for u in np.linspace(0.0, alpha, 11):
+        assert not check.check(x + u * dx, rest).violated

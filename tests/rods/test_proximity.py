@@ -20,7 +20,7 @@ D = 0.01
 MAT = Material(1e6, 0.5, 1000.0)
 
 
-def _brute(x, ev, rest, closed, hard=0.05, local=0.25):
+def _brute(x, ev, rest, closed, hard=0.045, local=0.225):
     """The same floor, every pair of edges sharing no vertex, one by one."""
     arc1 = np.cumsum(rest)
     arc0 = arc1 - rest
@@ -82,7 +82,7 @@ def test_a_crossing_is_found_and_named() -> None:
 
 def test_a_legal_tight_bend_passes() -> None:
     # A ring of diameter D (the tightest bend a tube of diameter D allows) at 40 vertices:
-    # its near pairs sit at the chord of the tightest bend, four times the floor.
+    # its near pairs sit at the chord of the tightest bend, 1/0.225 times the floor.
     s = np.linspace(0.0, 2 * np.pi, 40, endpoint=False)
     x = np.c_[0.5 * D * np.cos(s), 0.5 * D * np.sin(s), np.zeros(40)]
     m = _model(x, closed=True)

@@ -7,7 +7,7 @@ vertex (through a uniform grid of cells, in its own code), and reports the close
 against a floor, so that a pair any part of the contact model skips is named the moment it
 comes too close, not found later as a changed knot type.
 
-Floor of a pair of edges of one rod whose nearest points are an arc length s apart (rest
+Floor of a pair of edges of one rod whose nearest ends are an arc length s apart (rest
 lengths): ``min(hard, local * D sin(min(s / D, pi / 2)))``; D sin(s/D) is the chord between
 two points an arc s apart on the tightest bend a tube of diameter D allows (radius D/2), so
 a legal bend keeps every pair above ``local`` times it. Pairs of different rods, or farther
@@ -24,10 +24,12 @@ import numpy as np
 
 from tightknot.rods.model import Model
 
-#: Default floor of distant pairs over the pair's larger rest diameter.
-HARD_FRACTION = 0.05
-#: Default floor of near pairs over the chord of the tightest legal bend (module docstring).
-LOCAL_FRACTION = 0.25
+#: Default floor of distant pairs over the pair's larger rest diameter, and of near pairs
+#: over the chord of the tightest legal bend (module docstring): nine tenths of the contact
+#: layer's step-bound floors (0.05, 0.25), so that a step the bound allows never fails the
+#: check by round-off, while a pair the bound does not see fails it before it meets.
+HARD_FRACTION = 0.045
+LOCAL_FRACTION = 0.225
 
 
 @dataclass(frozen=True)
