@@ -26,6 +26,9 @@ class _Blocked:
     linear = SparseDirect()
     violation = None
 
+    def residual_floor(self):
+        return 0.0
+
     def __init__(self, n: int = 3) -> None:
         self.target = np.ones(n)
         self.accepted = 0

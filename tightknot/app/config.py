@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from tightknot.loading.options import LOADS, LoadPath, parameters
+from tightknot.loading.options import LOADS, REFINE_FROM, LoadPath, parameters
 from tightknot.study.params import (
     COLOR_ALIASES,
     COLOR_FIELDS,
@@ -60,16 +60,17 @@ class TieConfig(Output, LoadPath, Scene):
 
     def tie_options(self) -> dict[str, Any]:
         """Keyword options of :func:`tightknot.study.run.run_knot` for this config."""
+        refine = {} if self.coarse_nodes is None else {"coarse_nodes": self.coarse_nodes}
         if self.target_lambda is not None:
             return {"target_lambda": self.target_lambda, "tolerance": self.lambda_tolerance,
-                    "residual_tol": self.residual_tol}
+                    "residual_tol": self.residual_tol, **refine}
         opts: dict[str, Any] = {"tighten_steps": self.tighten_steps,
                                 "residual_tol": self.residual_tol,
                                 "relax_iterations": self.relax_iterations}
         if self.knot == "open":
             opts.update(pull_steps=self.pull_steps, pull_force=self.force,
                         end_distance=self.end_distance)
-        return opts
+        return {**opts, **refine}
 
 
 _PARAMS = parameters(TieConfig)
@@ -110,6 +111,8 @@ def config_from_dict(data: dict[str, Any]) -> TieConfig:
             clean[key] = value
     if clean.get("nodes") is None:
         clean["nodes"] = resolve_nodes({"diameter": Scene.diameter, **clean})
+    if clean.get("coarse_nodes") is None and clean["nodes"] > 2 * REFINE_FROM:
+        clean["coarse_nodes"] = REFINE_FROM  # a long rod ties coarse first (LoadPath)
     check_scene(clean)
     return TieConfig(**clean)
 

@@ -54,6 +54,7 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -139,6 +140,10 @@ class KnotScene:
     pull_axis: np.ndarray | None
     knot_type: str = "3_1"
     info: dict = field(default_factory=dict)
+    #: The same scene at another vertex count, ``rebuild(nodes)`` (mesh continuation:
+    #: tightknot.loading.refine), None when it cannot be rebuilt.
+    rebuild: Callable[[int], KnotScene] | None = field(default=None, repr=False,
+                                                        compare=False)
 
 
 #: Points of the start curve used to measure its spacing (see _largest_diameter).
@@ -163,7 +168,7 @@ def _largest_diameter(points: np.ndarray, closed: bool, diameter: float,
     return min(d, 2.0 / kmax) / clearance
 
 
-def _rotate_to_axes(points: np.ndarray, a: int, b: int, c: int) -> np.ndarray:
+def rotate_to_axes(points: np.ndarray, a: int, b: int, c: int) -> np.ndarray:
     """Rigidly move the curve so that vertex a is at the origin, b on +x, c in the x-y plane."""
     p = points - points[a]
     ex = p[b] / np.linalg.norm(p[b])
@@ -251,7 +256,7 @@ def _closed_knot(name: str, knot_type: str, curve: np.ndarray, ratio: float, d0:
     length = float(np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1).sum())
     pts *= ratio * d0 / length
     n = pts.shape[0]
-    pts = _rotate_to_axes(pts, 0, n // 3, 2 * n // 3)
+    pts = rotate_to_axes(pts, 0, n // 3, 2 * n // 3)
     # Grow the start until the tube D0 fits (scale >= 1 means the rest length shrinks).
     grow = max(1.0, d0 / _largest_diameter(pts, True, d0, clearance))
     pts *= grow
@@ -295,8 +300,11 @@ def closed_trefoil(
     nodes = default_nodes(ratio, True) if nodes is None else nodes
     d0 = _check_common(diameter, nodes, 24)
     twist, contact = check_twist(twist), check_contact(contact, law)
-    return _closed_knot("closed_trefoil", "3_1", curves.trefoil(4000), ratio, d0, nodes,
-                        material, law, twist, contact, device, clearance)
+    scene = _closed_knot("closed_trefoil", "3_1", curves.trefoil(4000), ratio, d0, nodes,
+                         material, law, twist, contact, device, clearance)
+    scene.rebuild = lambda n: closed_trefoil(l0_over_d0, diameter, n, material, law, twist,
+                                             device, clearance, contact)
+    return scene
 
 
 def closed_figure_eight(
@@ -318,8 +326,11 @@ def closed_figure_eight(
     nodes = default_nodes(ratio, True) if nodes is None else nodes
     d0 = _check_common(diameter, nodes, 32)
     twist, contact = check_twist(twist), check_contact(contact, law)
-    return _closed_knot("closed_figure_eight", "4_1", curves.figure_eight(4000), ratio, d0,
-                        nodes, material, law, twist, contact, device, clearance)
+    scene = _closed_knot("closed_figure_eight", "4_1", curves.figure_eight(4000), ratio, d0,
+                         nodes, material, law, twist, contact, device, clearance)
+    scene.rebuild = lambda n: closed_figure_eight(l0_over_d0, diameter, n, material, law,
+                                                  twist, device, clearance, contact)
+    return scene
 
 
 def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter: float,
@@ -388,7 +399,7 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
     axis /= np.linalg.norm(axis)
     radial = np.linalg.norm((pts - pts[0]) - np.outer((pts - pts[0]) @ axis, axis), axis=1)
     far = int(np.argmax(radial))
-    pts = _rotate_to_axes(pts, 0, n - 1, far)
+    pts = rotate_to_axes(pts, 0, n - 1, far)
     grow = max(1.0, d0 / _largest_diameter(pts, False, d0, clearance))
     pts *= grow
     _check_edge_length(pts, False, d0, nodes, contact)
@@ -431,9 +442,13 @@ def open_trefoil(
     zero, so the twist dofs change nothing (model only what the scene requires).
     ``contact``: contact level (module docstring).
     """
-    return _open_knot("open_trefoil", "3_1", curves.open_trefoil, rest_length, diameter,
-                      nodes, material, law, twist, contact, device, tail_fraction, clearance,
-                      corner_std=0.5, grip_length=grip_length, grip_twist=grip_twist)
+    scene = _open_knot("open_trefoil", "3_1", curves.open_trefoil, rest_length, diameter,
+                       nodes, material, law, twist, contact, device, tail_fraction, clearance,
+                       corner_std=0.5, grip_length=grip_length, grip_twist=grip_twist)
+    scene.rebuild = lambda n: open_trefoil(rest_length, diameter, n, material, law, twist,
+                                           device, tail_fraction, clearance, contact,
+                                           grip_length, grip_twist)
+    return scene
 
 
 def open_figure_eight(
@@ -458,10 +473,14 @@ def open_figure_eight(
     # Tail corners rounded with std 2 knot-size units within 5 units of them: the
     # trefoil's 0.5 leaves a corner whose bend, not the knot, sets the start's size, and
     # std 2 over the whole curve pulls the strands together.
-    return _open_knot("open_figure_eight", "4_1", curves.open_figure_eight, rest_length,
-                      diameter, nodes, material, law, twist, contact, device, tail_fraction,
-                      clearance, corner_std=2.0, grip_length=grip_length,
-                      grip_twist=grip_twist, corner_window=5.0)
+    scene = _open_knot("open_figure_eight", "4_1", curves.open_figure_eight, rest_length,
+                       diameter, nodes, material, law, twist, contact, device, tail_fraction,
+                       clearance, corner_std=2.0, grip_length=grip_length,
+                       grip_twist=grip_twist, corner_window=5.0)
+    scene.rebuild = lambda n: open_figure_eight(rest_length, diameter, n, material, law,
+                                                twist, device, tail_fraction, clearance,
+                                                contact, grip_length, grip_twist)
+    return scene
 
 
 def gauge(scene: KnotScene, positions: np.ndarray | None = None,

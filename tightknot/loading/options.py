@@ -220,6 +220,11 @@ def flag_kwargs(p: Param, nargs: str | None = None, what: str | None = None,
     return kw
 
 
+#: The coarse vertex count of the mesh continuation a run of a long rod takes by default:
+#: the relaxation of a loose start costs about a Newton iteration per vertex, and a rod of
+#: more than twice this many ties faster, and within the relaxation's budget, coarse first.
+REFINE_FROM = 300
+
 @dataclass(frozen=True)
 class LoadPath:
     """The load path that ties a knot (SI units): tighten (the rest length shrinks to L0),
@@ -247,6 +252,11 @@ class LoadPath:
                                 "Newton tolerance on the scaled residual")
     relax_iterations: int = param(2000, Range(1, 1_000_000), "",
                                   "Newton budget of the start curve's relaxation")
+    coarse_nodes: int | None = param(None, Range(24, 200_000), "",
+                                     "mesh continuation: tie at this many vertices first, "
+                                     "then refine by doubling (tightknot.loading.refine)",
+                                     default_text=f"{REFINE_FROM} for a rod of more than "
+                                     f"{2 * REFINE_FROM} vertices, else off", metavar="N")
 
 
 #: The loads of an open knot's pull: a run gives exactly one of them.

@@ -14,6 +14,7 @@ from tightknot.knots.scenes import (
     gauge,
     vertex_radii,
 )
+from tightknot.loading.diagnose import topology_change
 from tightknot.loading.levels import Check, LevelLoad, LevelOptions, LevelPath, SearchOptions
 from tightknot.loading.options import LoadPath
 from tightknot.loading.recentre import recentre_system
@@ -38,6 +39,7 @@ def pull_path(scene: KnotScene, tied: RodSystem, options: LevelOptions,
     bcs.rest_length_scale((shrink, shrink))
     bcs.force(0, end_vertex(scene), lambda t: load(t) * axis)
     system = RodSystem(scene.model, tied.state, bcs)
+    system.history = []  # a change of knot type is told from the iterates
     system.add_term(scene.contact)
     return LevelPath(system, load, options, level=load.end, check=check,
                      recentre=lambda s: recentre_system(scene, s)[1])
@@ -45,8 +47,9 @@ def pull_path(scene: KnotScene, tied: RodSystem, options: LevelOptions,
 
 def knot_kept(scene: KnotScene, types: list[str], rejected: bool,
               hook: StepHook | None = None) -> Check:
-    """A level path's check: the equilibrium keeps the scene's knot type (a change means
-    the knot slipped off an end or the rod passed through itself). Appends each accepted
+    """A level path's check: the equilibrium keeps the scene's knot type (a change is told
+    from the solve's iterates: the rod passing through itself, or an end leaving the knot,
+    :func:`tightknot.loading.diagnose.topology_change`). Appends each accepted
     equilibrium's type to ``types`` (``rejected``: each refused one's too), and calls
     ``hook("pull", system, record)`` with each accepted one."""
 
@@ -55,8 +58,8 @@ def knot_kept(scene: KnotScene, types: list[str], rejected: bool,
         if kt != scene.knot_type:
             if rejected:
                 types.append(kt)
-            return (f"knot type {kt} at force {force:.4g} N (the knot slipped off an end, or "
-                    "the rod passed through itself)")
+            why = topology_change(scene, system.history or [], system.rest, knot_type_of)
+            return f"knot type {kt} at force {force:.4g} N: {why}"
         types.append(kt)
         if hook is not None:
             hook("pull", system, rec)

@@ -115,6 +115,8 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
     become the system's state. ``newton(p, u0).run()`` returns the :class:`NewtonResult`.
     The Newton systems are solved by the system's linear solver (``p.linear``)."""
     opt = options or NewtonOptions()
+    # Round-off bounds what a tolerance can ask (RodSystem.residual_floor).
+    tol = max(opt.residual_tol, p.residual_floor())
     u = np.array(u0, dtype=np.float64)
     energy, g, hp = yield Evaluate(p, u, True, True)
     if not (math.isfinite(energy) and np.isfinite(g).all()):
@@ -125,7 +127,7 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
     history = [res]
     mu = 0.0
     step = math.inf
-    if res <= opt.residual_tol:
+    if res <= tol:
         yield from accept(p, u)
         return NewtonResult(True, 0, res, 0.0, energy, "converged", history)
     # Progress record of the stall test: best residual and energy after each iteration.
@@ -197,7 +199,7 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
             mu = max(4.0 * mu, opt.shift_trust)
         elif alpha == 1.0 and ratio > 0.75:
             mu = 0.0 if mu <= opt.shift_trust else mu / 4.0
-        if res <= opt.residual_tol:
+        if res <= tol:
             return NewtonResult(True, it, res, step, energy, "converged", history)
         # A tiny step that still cut the residual (a small correction, e.g. under the
         # stiff inertia of a short time step) is progress; one that did not is stagnation.

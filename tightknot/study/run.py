@@ -21,6 +21,7 @@ from tightknot.knots.measure import analyze_centerline
 from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import KnotScene, vertex_radii
 from tightknot.loading.pull import tie_to_lambda
+from tightknot.loading.refine import tie_refined
 from tightknot.loading.tie import TieResult, end_reaction, tie
 from tightknot.solvers.system import RodSystem
 from tightknot.viz.rerun_log import ROD_FIELDS
@@ -227,7 +228,12 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
         inner(phase, system, rec)
 
     target = tie_options.pop("target_lambda", None)
-    if target is not None:
+    coarse = tie_options.pop("coarse_nodes", None)
+    if coarse is not None and coarse < scene.model.vertex_count:
+        # Mesh continuation: the load path on a coarse copy, then refined.
+        res = tie_refined(scene, coarse, target_lambda=target, hook=hook,
+                          **tie_options).run()
+    elif target is not None:
         res = tie_to_lambda(scene, target, hook=hook, **tie_options).run()
     else:
         res = tie(scene, hook=hook, **tie_options).run()

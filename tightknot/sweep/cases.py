@@ -42,10 +42,11 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
 }
 #: Run parameters that are not case parameters, and why: a sweep's path pulls level by
 #: level with its own steps, ties with tie()'s relaxation, has no end-distance levels
-#: (its force levels are ``pull_force``), and writes no pictures; the device is the
+#: (its force levels are ``pull_force``), ties at the case's resolution (no mesh
+#: continuation), and writes no pictures; the device is the
 #: sweep's, not the case's.
 NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
-                 "color_by", "device")
+                 "coarse_nodes", "color_by", "device")
 #: Level lists of an open knot -> the load each level is (its range and unit).
 LEVELS = {"pull_force": "force", "target_lambda": "target_lambda"}
 LEVEL_KEYS = tuple(LEVELS)
