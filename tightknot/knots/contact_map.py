@@ -24,6 +24,34 @@ from tightknot.knots._arclength import (
 from tightknot.knots.curves import exclusion_arc_length
 
 
+def nonlocal_vertex_pairs(points: ArrayLike, closed: bool, radii: ArrayLike | float,
+                          tol: float, exclusion: float | None = None, extra: float = 0.0
+                          ) -> tuple[NDArray[np.float64], ...]:
+    """Vertex pairs (i < j) within 2 max(radii) (1 + ``tol``) + ``extra`` [m] of each other
+    that are farther apart along the curve than the non-local window ``exclusion`` [m]
+    (default pi D_max / 2 with D_max = 2 max(radii)): the points (N, 3), the radii
+    broadcast to (N,), i, j and the pairs' distances [m]. ``radii`` [m]: one or one per
+    vertex, positive and finite."""
+    p = as_points(points)
+    n = p.shape[0]
+    a = np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,))
+    if np.any(a <= 0) or not np.all(np.isfinite(a)):
+        raise ValueError("radii must be positive and finite")
+    if exclusion is None:
+        exclusion = exclusion_arc_length(2.0 * float(a.max()))
+    s = vertex_arclength(p, closed)
+    length = total_length(p, closed)
+    reach = 2.0 * float(a.max()) * (1.0 + tol) + extra
+    pairs = cKDTree(p).query_pairs(reach, output_type="ndarray")
+    if pairs.size == 0:
+        e = np.zeros(0, dtype=np.int64)
+        return p, a, e, e, np.zeros(0)
+    i, j = pairs[:, 0], pairs[:, 1]
+    keep = arc_separation(s[i], s[j], length, closed) > exclusion
+    i, j = i[keep], j[keep]
+    return p, a, i, j, np.linalg.norm(p[i] - p[j], axis=1)
+
+
 def contact_pairs(
     points: ArrayLike,
     closed: bool,
@@ -38,25 +66,11 @@ def contact_pairs(
     Both orders (i, j) and (j, i) are returned, so the map is symmetric by construction;
     sorted by i then j.
     """
-    p = as_points(points)
-    n = p.shape[0]
-    a = np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,))
-    if np.any(a <= 0) or not np.all(np.isfinite(a)):
-        raise ValueError("radii must be positive and finite")
-    if exclusion is None:
-        exclusion = exclusion_arc_length(2.0 * float(a.max()))
-    s = vertex_arclength(p, closed)
-    length = total_length(p, closed)
-    tree = cKDTree(p)
-    pairs = tree.query_pairs(2.0 * float(a.max()) * (1.0 + tol), output_type="ndarray")
-    if pairs.size == 0:
+    p, a, i, j, d = nonlocal_vertex_pairs(points, closed, radii, tol, exclusion)
+    if i.size == 0:
         e = np.zeros(0, dtype=np.int64)
         return e, e
-    i, j = pairs[:, 0], pairs[:, 1]
-    d = np.linalg.norm(p[i] - p[j], axis=1)
-    keep = (d <= (a[i] + a[j]) * (1.0 + tol)) & (
-        arc_separation(s[i], s[j], length, closed) > exclusion
-    )
+    keep = d <= (a[i] + a[j]) * (1.0 + tol)
     i, j = i[keep], j[keep]
     ii = np.concatenate([i, j]).astype(np.int64)
     jj = np.concatenate([j, i]).astype(np.int64)

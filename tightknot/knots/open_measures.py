@@ -17,10 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import cKDTree
 
-from tightknot.knots._arclength import arc_separation, as_points, total_length, vertex_arclength
-from tightknot.knots.curves import exclusion_arc_length
+from tightknot.knots._arclength import as_points
+from tightknot.knots.contact_map import nonlocal_vertex_pairs
 
 
 def contact_gaps(points: ArrayLike, closed: bool, radii: ArrayLike | float,
@@ -31,25 +30,13 @@ def contact_gaps(points: ArrayLike, closed: bool, radii: ArrayLike | float,
     an edge. ``radii``: one radius [m] or one per vertex; ``exclusion``: the non-local
     window [m] (default pi D_max / 2, D_max = 2 max(radii))."""
     p = as_points(points)
-    n = p.shape[0]
-    a = np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,))
-    if np.any(a <= 0) or not np.all(np.isfinite(a)):
-        raise ValueError("radii must be positive and finite")
-    if exclusion is None:
-        exclusion = exclusion_arc_length(2.0 * float(a.max()))
-    s = vertex_arclength(p, closed)
-    length = total_length(p, closed)
     edge = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    # Far enough to give the neighbours of a contact vertex their (positive) gap too.
-    reach = 2.0 * float(a.max()) * (1.0 + tol) + (float(edge.max()) if edge.size else 0.0)
-    gaps = np.full(n, np.inf)
-    pairs = cKDTree(p).query_pairs(reach, output_type="ndarray")
-    if pairs.size == 0:
-        return gaps
-    i, j = pairs[:, 0], pairs[:, 1]
-    keep = arc_separation(s[i], s[j], length, closed) > exclusion
-    i, j = i[keep], j[keep]
-    g = np.linalg.norm(p[i] - p[j], axis=1) - (a[i] + a[j]) * (1.0 + tol)
+    # An edge farther than the contact test: the neighbours of a contact vertex get their
+    # (positive) gap too.
+    p, a, i, j, d = nonlocal_vertex_pairs(p, closed, radii, tol, exclusion,
+                                          extra=float(edge.max()) if edge.size else 0.0)
+    gaps = np.full(p.shape[0], np.inf)
+    g = d - (a[i] + a[j]) * (1.0 + tol)
     np.minimum.at(gaps, i, g)
     np.minimum.at(gaps, j, g)
     return gaps
