@@ -89,15 +89,22 @@ class LevelLoad:
 class Contact(Protocol):
     """What :func:`keeps_clear` uses of a contact layer."""
 
+    last_rest: np.ndarray
+
     def min_distance(self, x: np.ndarray) -> tuple: ...
+
+    def max_step(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray) -> float: ...
 
 
 def keeps_clear(contact: Contact, ratio: float = 0.9) -> Guard:
     """A predictor guard: the guess may not bring two pieces of rod closer than ``ratio``
-    times their closest distance now (a predictor must not push the rod into, or through,
-    itself; Newton's contact step bound protects only its own steps)."""
+    times their closest distance now, and the straight way to it must pass the contact's
+    step bound whole (a predictor must not push the rod into, or through, itself:
+    Newton's step bound protects only its own steps)."""
 
     def guard(x: np.ndarray, guess: np.ndarray) -> bool:
+        if contact.max_step(x, guess - x, contact.last_rest) < 1.0:
+            return False
         return contact.min_distance(guess)[0] >= ratio * contact.min_distance(x)[0]
 
     return guard
@@ -291,6 +298,9 @@ class LevelPath:
             system.state.x = guess
         self.load.hold(value)
         system.set_load(1.0)
+        if guess is not None and system.history is not None:
+            # The predictor's jump is part of the way a knot type could change.
+            system.history.insert(0, saved.x.copy())
         self.solves += 1
         r = yield from newton(system, system.free_vector(), opts.newton)
         self.iterations += r.iterations
