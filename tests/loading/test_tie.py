@@ -135,6 +135,10 @@ def test_a_knot_that_slips_off_a_hinged_end_says_so() -> None:
     res = tie(open_trefoil(nodes=90, grip_length=0.0), pull_force=0.3, tighten_steps=20).run()
     assert not res.converged
     assert "knot type 0_1" in res.failure and "an end left the knot" in res.failure
+    # The result carries the force of the last equilibrium, where the pull stopped (it
+    # ramps down from the tightening's end force to 0.3 N), not the force aimed at.
+    assert 0.0 < res.phases["pull"].t < 1.0
+    assert res.pull_force_N > 0.3
 
 
 def test_a_pass_through_between_iterates_is_named() -> None:

@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from tightknot.loading.options import LOADS, REFINE_FROM, LoadPath, parameters
+from tightknot.loading.options import LOADS, LoadPath, default_coarse_nodes, parameters
 from tightknot.study.params import (
     COLOR_ALIASES,
     COLOR_FIELDS,
@@ -111,8 +111,8 @@ def config_from_dict(data: dict[str, Any]) -> TieConfig:
             clean[key] = value
     if clean.get("nodes") is None:
         clean["nodes"] = resolve_nodes({"diameter": Scene.diameter, **clean})
-    if clean.get("coarse_nodes") is None and clean["nodes"] > 2 * REFINE_FROM:
-        clean["coarse_nodes"] = REFINE_FROM  # a long rod ties coarse first (LoadPath)
+    if clean.get("coarse_nodes") is None:
+        clean["coarse_nodes"] = default_coarse_nodes(clean["nodes"])  # a long rod ties coarse
     check_scene(clean)
     return TieConfig(**clean)
 

@@ -98,7 +98,7 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
     p = subparsers.add_parser(
         "force-range", help="the open trefoil pulled from its loosest force to 0.3 EA "
         "(185 mm, 125 mm, 1 m rods): reached, knot type, Lambda_OC, gap at every level",
-        description=__doc__.split("\n\n")[0] + ".", epilog=_EXAMPLES,
+        description=__doc__.split("\n\n")[0], epilog=_EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--json", metavar="FILE", help="write the rows as JSON")
     p.add_argument("--lengths", type=float, nargs="+", default=list(DEFAULT_LENGTHS),

@@ -225,6 +225,12 @@ def flag_kwargs(p: Param, nargs: str | None = None, what: str | None = None,
 #: more than twice this many ties faster, and within the relaxation's budget, coarse first.
 REFINE_FROM = 300
 
+
+def default_coarse_nodes(nodes: int) -> int | None:
+    """The coarse vertex count a rod of ``nodes`` vertices ties on first by default
+    (:data:`REFINE_FROM` above twice that many, else None: no mesh continuation)."""
+    return REFINE_FROM if nodes > 2 * REFINE_FROM else None
+
 @dataclass(frozen=True)
 class LoadPath:
     """The load path that ties a knot (SI units): tighten (the rest length shrinks to L0),

@@ -62,7 +62,8 @@ class TieResult:
         newton_iterations: total Newton iterations.
         wall_time_s: wall-clock time [s].
         knot_types: knot type after each converged load step.
-        pull_force_N: final pulling force (open knots) [N].
+        pull_force_N: final pulling force (open knots) [N]; of a failed pull, the force of
+            its last equilibrium.
         system: the last phase's system (its state is the result; after a failed load
             step, the last equilibrium).
         failed_state: where the failing load step's solve stopped (None when converged).
@@ -281,6 +282,9 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
         # Reaction at the moved end: the residual force there is the pulling force.
         final_force = end_reaction(system)
     if not res.converged:
+        if pull_force is not None:
+            # The force of the last equilibrium (the state kept), not the one aimed at.
+            final_force = f0 * (pull_force / f0) ** res.t
         return fail(f"pull: {res.failure}", system, final_force, res.failed_state)
     return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                      final_force, system)

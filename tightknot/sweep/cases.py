@@ -42,9 +42,9 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
 }
 #: Run parameters that are not case parameters, and why: a sweep's path pulls level by
 #: level with its own steps, ties with tie()'s relaxation, has no end-distance levels
-#: (its force levels are ``pull_force``), ties at the case's resolution (no mesh
-#: continuation), and writes no pictures; the device is the
-#: sweep's, not the case's.
+#: (its force levels are ``pull_force``), ties a long rod by mesh continuation from the
+#: coarse count that its vertex count implies (``default_coarse_nodes``), and writes no
+#: pictures; the device is the sweep's, not the case's.
 NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
                  "coarse_nodes", "color_by", "device")
 #: Level lists of an open knot -> the load each level is (its range and unit).

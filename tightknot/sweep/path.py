@@ -1,20 +1,21 @@
 """Tightness sweep of an open knot along ONE continuation path.
 
-The knot is tied once (:func:`tightknot.loading.tie.tie`: rest length shrunk to L0, end held),
-then pulled by a dead force on its sliding end, level after level, each level's equilibrium
-starting from the previous one. The levels are visited from the loosest to the tightest (a
-pull that only grows, as in the study's experiments; physics.md sec. 1): pulling forces in
-increasing order, or target knot lengths Lambda_OC in decreasing order. The pull is a level
-path in the force (:class:`tightknot.loading.levels.LevelPath`, set up by
+The knot is tied once (:func:`tightknot.loading.tie.tie`: rest length shrunk to L0, end held; a
+long rod coarse first and refined, as ``tightknot tie`` does), then pulled by a dead force on
+its sliding end, level after level, each level's equilibrium starting from the previous one.
+The levels are visited from the loosest to the tightest (a pull that only grows, as in the
+study's experiments; physics.md sec. 1): pulling forces in increasing order, or target knot
+lengths Lambda_OC in decreasing order. The pull is a level path in the force
+(:class:`tightknot.loading.levels.LevelPath`, set up by
 :func:`tightknot.loading.pull.pull_path`, as tie_to_lambda's): a force level is one static
-solve (split into smaller force steps where Newton fails, :func:`path_options`); a
-Lambda_OC level is the search of :func:`tightknot.loading.pull.tie_to_lambda` (force steps
-until the target is bracketed, then a search on the force inside the bracket) started from
-the previous level's force and shape instead of from the tied knot, its force predicted
-from the previous levels (secant in log F, :func:`path_search`), and every solve starts
-from the secant extrapolation of the last two equilibria. So twenty levels cost the tie
-plus twenty short searches, little more than the tightest level alone (``tightknot bench
-sweep`` measures the ratio).
+solve (split into smaller force steps where Newton fails, :func:`path_options`); a Lambda_OC
+level is the search of :func:`tightknot.loading.pull.tie_to_lambda` (force steps until the
+target is bracketed, then a search on the force inside the bracket) started from the previous
+level's force and shape instead of from the tied knot, its force predicted from the previous
+levels (secant in log F, :func:`path_search`), and every solve starts from the secant
+extrapolation of the last two equilibria. So twenty levels cost the tie plus twenty short
+searches, little more than the tightest level alone (``tightknot bench sweep`` measures the
+ratio).
 
 Every converged solve is checked for the knot type (Alexander polynomial): a change is a
 topology failure (the knot slipped off an end or the rod passed through itself), never
@@ -33,8 +34,9 @@ from typing import Any
 
 from tightknot.knots.scenes import KnotScene, vertex_radii
 from tightknot.loading.levels import LevelOptions, SearchOptions, SecantPredictor, keeps_clear
-from tightknot.loading.options import LoadPath
+from tightknot.loading.options import LoadPath, default_coarse_nodes
 from tightknot.loading.pull import knot_kept, knot_length, pull_path
+from tightknot.loading.refine import tie_refined
 from tightknot.loading.tie import TieResult, tie
 from tightknot.solvers.newton import NewtonOptions
 from tightknot.solvers.program import Coroutine, Program
@@ -162,6 +164,7 @@ def tightness_path(
     proximal_steps: int = 60,
     predictor: bool = True,
     on_level: Callable[[LevelResult], None] | None = None,
+    coarse_nodes: int | str | None = "auto",
 ) -> PathResult:
     """Tie the open knot ``scene`` once, then reach each level from the previous one.
 
@@ -177,6 +180,10 @@ def tightness_path(
         predictor: start each solve from the secant extrapolation of the last two
             equilibria (in log force) instead of from the last one.
         on_level: called with each level's result as soon as it is measured.
+        coarse_nodes: tie by mesh continuation from this many vertices
+            (:func:`tightknot.loading.refine.tie_refined`); "auto": the rule of ``tightknot
+            tie`` (:func:`tightknot.loading.options.default_coarse_nodes`) where the scene
+            can be rebuilt; None: tie at the scene's own resolution.
     """
     if scene.closed:
         raise ValueError("a tightness path is for open knots (the closed knot is not pulled)")
@@ -188,19 +195,30 @@ def tightness_path(
         raise ValueError(f"{kind} must be a non-empty list of finite values > 0, got {raw!r}")
     if not (math.isfinite(lambda_tolerance) and lambda_tolerance > 0):
         raise ValueError(f"lambda_tolerance must be finite and > 0, got {lambda_tolerance!r}")
+    if coarse_nodes == "auto":
+        coarse_nodes = (default_coarse_nodes(scene.model.vertex_count)
+                        if scene.rebuild is not None else None)
+    elif coarse_nodes is not None and not (isinstance(coarse_nodes, int)
+                                           and 2 <= coarse_nodes < scene.model.vertex_count):
+        raise ValueError(f"coarse_nodes must be 'auto', None or an int in [2, "
+                         f"{scene.model.vertex_count}), got {coarse_nodes!r}")
     levels = sorted(raw, reverse=(kind == LAMBDA))
     return Program(_tightness_path(scene, kind, levels, lambda_tolerance, residual_tol,
-                                   tighten_steps, proximal_steps, predictor, on_level),
-                   "tightness_path").run()
+                                   tighten_steps, proximal_steps, predictor, on_level,
+                                   coarse_nodes), "tightness_path").run()
 
 
 def _tightness_path(scene: KnotScene, kind: str, levels: list[float], lambda_tolerance: float,
                     residual_tol: float, tighten_steps: int, proximal_steps: int,
-                    predictor: bool, on_level: Callable[[LevelResult], None] | None
-                    ) -> Coroutine[PathResult]:
+                    predictor: bool, on_level: Callable[[LevelResult], None] | None,
+                    coarse_nodes: int | None) -> Coroutine[PathResult]:
     """The coroutine of :func:`tightness_path` (its arguments checked, levels in order)."""
     start = time.perf_counter()
-    tied = yield from tie(scene, tighten_steps=tighten_steps, residual_tol=residual_tol)
+    if coarse_nodes is None:
+        tied = yield from tie(scene, tighten_steps=tighten_steps, residual_tol=residual_tol)
+    else:
+        tied = yield from tie_refined(scene, coarse_nodes, tighten_steps=tighten_steps,
+                                      residual_tol=residual_tol)
     t_tie = time.perf_counter() - start
     if not tied.converged:
         return PathResult(False, f"tie: {tied.failure}", tied, [], t_tie,
