@@ -155,9 +155,12 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         # No pair within the interaction range (a knot that came undone): no gap to report
         # (JSON has no infinity).
         "min_gap_over_D0": dmin / scene.diameter if math.isfinite(dmin) else None,
-        "max_pressure_over_E": float(np.max(contact.peak_pressure_over_E)),
+        # A rigid tube reports no pressure and no width (contact_report): null, not 0.
+        "max_pressure_over_E": (None if scene.contact.law.rigid
+                                else float(np.max(contact.peak_pressure_over_E))),
         "min_area_ratio": float(np.min(contact.area_ratio)),
-        "max_contact_width_fraction": float(np.max(contact.contact_width_fraction)),
+        "max_contact_width_fraction": (None if scene.contact.law.rigid
+                                       else float(np.max(contact.contact_width_fraction))),
         "kappa_D0_max": rep["kappa_D0_max"],
         "kappa_D0_min": rep["kappa_D0_min"],
         "s": s.tolist(),
