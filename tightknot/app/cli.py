@@ -383,6 +383,9 @@ def build_parser() -> argparse.ArgumentParser:
     register_fem(sub)
     register_bench(sub)
     register_sweep(sub)
+    from tightknot.app.sweep_outputs import register as register_sweep_outputs
+
+    register_sweep_outputs(sub)
     return parser
 
 

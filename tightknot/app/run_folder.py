@@ -149,7 +149,7 @@ def refuse_existing(paths: list[Path], flag: str) -> None:
     if taken:
         names = ", ".join(str(p) for p in taken)
         raise ValueError(f"{names}: already written by an earlier run; give {flag} to "
-                         "replace it, or another folder")
+                         "replace it, or choose another output")
 
 
 def write_centerline(path: Path, x: np.ndarray, scene_name: str, diameter: float,
