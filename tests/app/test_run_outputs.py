@@ -87,3 +87,24 @@ def test_license_is_the_bsd_3_clause_of_pyproject() -> None:
     assert 'license = { text = "BSD-3-Clause" }' in (root / "pyproject.toml").read_text()
     assert text.startswith("BSD 3-Clause License") and "the tightknot developers" in text
     assert "Neither the name of the copyright holder" in text
+
+
+def test_resolution_note_quotes_the_trade_off_numbers_of_the_readme() -> None:
+    from tightknot.study.resolution import (
+        CLOSED_KAPPA_RMS_AT_100,
+        OPEN_KAPPA_ERROR_100_200,
+        RECOMMENDED_NODES,
+        resolution_note,
+    )
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    lo, hi = OPEN_KAPPA_ERROR_100_200
+    # The numbers are the README's own, not new ones.
+    assert f"At 100 to 200 vertices the curvature error is {lo:g} to {hi:g}" in readme
+    assert f"100 vertices, `residual_tol=1e-3`: kappa*D0 within {CLOSED_KAPPA_RMS_AT_100:g}" \
+        in readme
+    assert f"{RECOMMENDED_NODES['open']} vertices, `residual_tol=1e-3`" in readme
+    assert resolution_note(False, 150)["warning"] is not None
+    assert resolution_note(False, 400)["warning"] is None
+    assert resolution_note(True, 100)["warning"] is None
+    assert "not measured" in resolution_note(True, 60)["warning"]

@@ -163,7 +163,8 @@ def _cmd_tie(args: argparse.Namespace) -> int:
                 print(f"  {k:28s} {summary[k]}")
         print(written_outputs(outs, figures))
         print(f"look at it: tightknot view {outs.rrd}")
-    for warning in summary.get("warnings", []):
+    coarse = (summary.get("resolution") or {}).get("warning")
+    for warning in [*summary.get("warnings", []), *([coarse] if coarse else [])]:
         print(f"tightknot tie: warning: {warning}", file=sys.stderr)
     if not run.result.converged:
         print(f"tightknot tie: failed: {run.result.failure} (after {summary['load_steps']} "

@@ -24,6 +24,7 @@ from tightknot.loading.pull import tie_to_lambda
 from tightknot.loading.refine import tie_refined
 from tightknot.loading.tie import TieResult, end_reaction, tie
 from tightknot.solvers.system import RodSystem
+from tightknot.study.resolution import resolution_note
 from tightknot.viz.rerun_log import ROD_FIELDS
 
 #: Contact tolerance of the measurements (the default of tightknot.knots.measure).
@@ -262,6 +263,9 @@ def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
     contact = contact_report(scene.contact, x, res.system.rest)
     summary = summarise(scene, res, rep, contact)
     summary["load_steps"] = load_steps
+    # What the mesh costs in accuracy, so a coarse run says so (the trade-off study's numbers);
+    # its warning stays in this entry: "warnings" are about the contact law's validity.
+    summary["resolution"] = resolution_note(scene.closed, scene.model.vertex_count)
     return KnotRun(scene, res, rep, contact, summary)
 
 
