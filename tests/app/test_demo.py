@@ -48,8 +48,11 @@ def test_demo_outputs(tmp_path) -> None:
     pts = last_points3d(rrd, "/open_185mm/rod/vertices")
     assert pts.shape == (150, 3) and np.isfinite(pts).all()
     # The open knots' series: end-to-end distance, pulling force, Lambda_OC once in contact.
+    # The tightening's and the pull's series apart (issue 20).
     for key in ("end_to_end", "pulling_force", "lambda_oc"):
-        assert f"/plots/open_125mm/{key}" in paths, key
+        assert f"/plots/open_125mm/pull/{key}" in paths, key
+    assert "/plots/open_125mm/tighten/pulling_force" in paths
+    assert "/plots/open_125mm/pulling_force" not in paths
     # Each knot's rod is logged once per converged load step: those of its tightening and
     # each equilibrium of the force search toward Lambda_OC (the last is the final state).
     closed_steps = steps(rrd, "/closed/rod/vertices", "Points3D:positions")
@@ -57,5 +60,5 @@ def test_demo_outputs(tmp_path) -> None:
     tight_steps = steps(rrd, "/open_125mm/rod/vertices", "Points3D:positions")
     assert len(tight_steps) == tight["load_steps"]
     # The final force of the search is the last logged pulling force (float32 in rerun).
-    _, force = scalar_series(rrd, "/plots/open_125mm/pulling_force")
+    _, force = scalar_series(rrd, "/plots/open_125mm/pull/pulling_force")
     assert abs(force[-1] - tight["pull_force_N"]) <= 1e-4 * tight["pull_force_N"]

@@ -108,3 +108,34 @@ def test_resolution_note_quotes_the_trade_off_numbers_of_the_readme() -> None:
     assert resolution_note(False, 400)["warning"] is None
     assert resolution_note(True, 100)["warning"] is None
     assert "not measured" in resolution_note(True, 60)["warning"]
+
+
+def test_tie_keeps_the_pull_s_force_extension_apart(tmp_path: Path) -> None:
+    import json
+
+    import numpy as np
+
+    from tightknot.viz.rrd_read import entity_paths, scalar_series
+
+    out = tmp_path / "open"
+    assert main(["tie", "open", "--nodes", "90", "--force", "3", "--tighten-steps", "20",
+                 "--quiet", "--out", str(out)]) == 0
+    data = json.loads((out / "summary.json").read_text())
+    series = data["pull_series"]
+    forces, ends = series["pull_force_N"], series["end_to_end_m"]
+    assert len(forces) == len(ends) == len(series["lambda_oc"]) >= 1
+    # The last equilibrium of the pull is the final state the summary describes; its end
+    # reaction equals the dead load up to the Newton residual (tolerance 1e-6, scaled).
+    assert forces[-1] == pytest.approx(data["pull_force_N"], rel=1e-6)
+    x = np.array(data["centerline_m"])
+    assert ends[-1] == float(np.linalg.norm(x[-1] - x[0]))
+    assert series["lambda_oc"][-1] == data["lambda_oc"]
+    # A force-driven pull only grows: a harder pull, a longer rod.
+    assert forces == sorted(forces) and ends == sorted(ends)
+    rrd = out / "run.rrd"
+    paths = entity_paths(rrd)
+    assert "/plots/open/tighten/pulling_force" in paths and "/plots/open/pulling_force" \
+        not in paths
+    _, logged = scalar_series(rrd, "/plots/open/pull/pulling_force")
+    # One logged point per equilibrium of the pull; rerun stores float32 (1e-6 relative).
+    assert np.allclose(logged, forces, rtol=1e-6, atol=0)
