@@ -10,13 +10,13 @@ export WARP_CACHE_PATH ?= $(CURDIR)/.warp_cache
 $(BIN)/tightknot: pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[fem,test,distributed]"
+	$(BIN)/python -m pip install --quiet -e ".[fem,test,distributed,tables]"
 	touch $(BIN)/tightknot
 
 venv: $(BIN)/tightknot
 
 demo: venv
-	$(BIN)/tightknot demo --out runs/demo
+	$(BIN)/tightknot demo --out runs/demo --overwrite
 
 # CI and `make test`: everything but the long checks (marked slow: the FEM's fine meshes).
 test: venv

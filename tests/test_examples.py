@@ -48,3 +48,29 @@ def test_readme_python_tour_runs(tmp_path, monkeypatch, capsys) -> None:
     # the digits it shows.
     assert round(float(printed[2]), 4) == 1.0748 and round(float(printed[3]), 3) == 0.971
     assert (tmp_path / "trefoil.rrd").stat().st_size > 0
+
+
+def test_readme_data_and_sweep_sections_run(tmp_path, monkeypatch) -> None:
+    # The README's "Your own data" and "Sweep to table to plot" commands, run as written
+    # (in a scratch folder; the shipped file's path made absolute).
+    import csv
+    import re
+    import shlex
+
+    from tightknot.app.cli import main
+
+    readme = (EXAMPLES.parent / "README.md").read_text()
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "runs").mkdir()  # a checkout's runs/ (make demo makes it)
+    for title in ("## Your own data", "## Sweep to table to plot"):
+        block = re.search(r"```sh\n(.*?)```", readme.split(title, 1)[1], re.S).group(1)
+        for line in block.strip().splitlines():
+            argv = shlex.split(line)[1:]
+            argv = [str(EXAMPLES.parent / a) if a.startswith("tightknot/knots/data") else a
+                    for a in argv]
+            assert main(argv) == 0, line
+    assert (tmp_path / "ideal.json").is_file()
+    with (tmp_path / "f.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert [float(r["level_target"]) for r in rows] == [2.0, 3.0]
+    assert (tmp_path / "runs/f/figures/force_extension.png").is_file()

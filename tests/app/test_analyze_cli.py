@@ -159,7 +159,7 @@ def test_round_trip_closed_in_mm(tmp_path, smooth):
     # mm -> m rescaling rounds in the last bits only.
     _assert_same(got, want, rtol=1e-9)
     assert got["input"] == {"file": str(path), "units_m_per_file_unit": 1e-3,
-                            "closed_source": "inferred"}
+                            "units": "mm (--units)", "closed_source": "inferred"}
     # Stretch of the measured curve; the Gaussian average shortens it (cuts the bends).
     assert got["stretch_L_over_L0"] == pytest.approx(got["length_L"] / l0, rel=1e-12)
     if smooth is None:

@@ -36,6 +36,14 @@ def test_grid_is_the_product_of_the_axes_without_duplicates() -> None:
     # 18 and 18.0 are one case.
     assert len(grid({"knot": "closed"}, l0_over_d0=[18, 18.0])) == 1
     assert "l0_over_d0=18" in cases[2].label()
+    # Every parameter is named, defaults included (issue 20: "nodes=100 pull_force=3
+    # levels" did not say which rod).
+    open_case = grid({"knot": "open", "pull_force": [3.0, 2.0]}, nodes=[100])[0]
+    label = open_case.label()
+    for key in open_case.params:
+        if key != "knot":
+            assert f"{key}=" in label, key
+    assert "length=0.185" in label and "pull_force=[2, 3]" in label
 
 
 @pytest.mark.parametrize(("params", "words"), [

@@ -1,6 +1,6 @@
 """A tightness sweep along one continuation path: the open trefoil tied once, then pulled
 level by level; a level the knot cannot reach (it slips off below a minimum force) is
-reported as failed and the path goes on."""
+marked as missed (a warning) and the path goes on."""
 
 import math
 
@@ -25,7 +25,9 @@ def test_levels_along_one_path_and_an_unreachable_level_reported() -> None:
     slip = levels[0]
     assert not slip["reached"] and slip["summary"] is None
     assert "knot type 0_1" in slip["failure"] or "knot type undefined" in slip["failure"]
-    assert rec["status"] == "failed" and "pull_force = 0.3" in rec["failure"]
+    # The missed level is a warning; the reached ones keep the case ok (issue 20).
+    assert rec["status"] == "ok" and rec["failure"] == ""
+    assert len(rec["warnings"]) == 1 and "pull_force = 0.3 not reached" in rec["warnings"][0]
     # The path goes on from the last good equilibrium and reaches the other levels exactly.
     for lv in levels[1:]:
         assert lv["reached"], lv["failure"]

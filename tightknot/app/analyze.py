@@ -46,10 +46,22 @@ _ANALYZE_EXAMPLES = """examples:
   # the shipped ideal trefoil (tube diameter 1 in its own units)
   tightknot analyze tightknot/knots/data/ideal_trefoil_ridgerunner_cc0_n2400.tsv --diameter 1
 
-file format: one vertex per line, x y z separated by commas, tabs or spaces; '#' starts a
-comment; one header line of names allowed. Without --closed/--open the curve is closed when
-its ends join within 5 mean edge lengths (a closed file may repeat its first vertex at the
-end). Exit codes: 0 ok, 2 bad input (one line on stderr naming the file and line).
+  # a micro-CT export: index column, 'x [mm];y [mm];z [mm]' header, decimal commas
+  tightknot analyze scan.csv --diameter 8.5 --closed        # units from the header
+  tightknot analyze table.csv --columns 3,4,5 --diameter 8.5 --units mm
+  tightknot analyze knot.vect --diameter 0.1                # Geomview VECT (KnotPlot too)
+
+file formats: one vertex per line, x y z separated by ';', tabs, commas or spaces (with ';'
+or tabs a comma is a decimal comma); '#' starts a comment; any number of header lines; a
+4th column that counts 1, 2, 3... is a row index and dropped; other columns are chosen by
+the header's x/y/z names or by --columns. A header unit ('x [mm]', 'x (mm)', 'x_mm') is
+the file's unit unless --units says the same. Geomview VECT/4VECT of one polyline (a
+negative vertex count: closed); KnotPlot's ASCII coordinates (its binary files are
+refused). Without --closed/--open the curve is closed when its ends join within 5 mean
+edge lengths (a closed file may repeat its first vertex at the end).
+--smooth on an open curve moves its ends inward (the study's truncated window): its length,
+stretch and L/D come out low, and a warning says by how much (measure them unsmoothed).
+Exit codes: 0 ok, 2 bad input (one line on stderr naming the file and line, or the option).
 """
 
 
@@ -73,9 +85,14 @@ def register(subparsers: Any) -> None:
     p.add_argument("--smooth", type=float, default=None, metavar="N_GAUSS",
                    help="apply the study's smoothing first: resample at D0/60, Gaussian window "
                         "round(N_b/N_GAUSS) points (the study used 25); default: raw polygon")
-    p.add_argument("--units", default="m", metavar="UNIT",
+    p.add_argument("--units", default=None, metavar="UNIT",
                    help="unit of the file and of --diameter/--rest-length: m, cm, mm, um, or "
-                        "a factor in metres per file unit (default m)")
+                        "a factor in metres per file unit (default: the unit the header "
+                        "names, as in 'x [mm]' or 'x_mm', else m)")
+    p.add_argument("--columns", default=None, metavar="X,Y,Z",
+                   help="the x, y, z columns: 1-based numbers (2,3,4) or header names "
+                        "(default: the only three, the header's x y z, or the three after a "
+                        "row-index column)")
     p.add_argument("--rest-length", type=float, default=None, metavar="L0",
                    help="rest length L0 in --units (default: the measured length, stretch 1)")
     p.add_argument("--poisson", type=float, default=0.5, metavar="NU",
@@ -134,14 +151,25 @@ def _check_options(args: argparse.Namespace) -> float:
     # -1 < nu <= 0.5: the range of an isotropic elastic solid (0.5 incompressible).
     if not (math.isfinite(args.poisson) and -1.0 < args.poisson <= 0.5):
         raise _BadInput(f"--poisson must be in (-1, 0.5], got {args.poisson:g}")
-    factor = parse_units(args.units)
+    if args.units is not None:
+        parse_units(args.units)
+    if args.columns is not None:
+        from tightknot.knots.centerline_io import parse_columns
+
+        try:
+            args.columns = parse_columns(args.columns)
+        except ValueError as err:
+            raise _BadInput(str(err)) from None
+    _check_json_path(args.json)
+    _check_figures_dir(args.figures)
+    return 1.0 if args.units is None else parse_units(args.units)
+
+
+def _check_scaled(args: argparse.Namespace, factor: float) -> None:
     # The lengths in SI must stay finite and non-zero after scaling.
     for name, value in (("--diameter", args.diameter), ("--rest-length", args.rest_length)):
         if value is not None and not (0 < value * factor < math.inf):
             raise _BadInput(f"{name} {value:g} overflows or vanishes in metres (--units)")
-    _check_json_path(args.json)
-    _check_figures_dir(args.figures)
-    return factor
 
 
 def _check_json_path(path: str | None) -> None:
@@ -175,17 +203,22 @@ def _check_figures_dir(path: str | None) -> None:
         raise _BadInput(f"--figures {path}: parent folder does not exist: {parent}")
 
 
-def read_points(path: str, factor: float, closed: bool | None) -> tuple[np.ndarray, bool]:
-    """Read FILE [m]; with ``closed`` None infer it from the file. Returns (points, closed).
+def read_points(path: str, factor: float, closed: bool | None,
+                columns: tuple | None = None) -> tuple[np.ndarray, bool]:
+    """Read FILE [m]; with ``closed`` None take it from the file (a VECT's closed polyline)
+    or infer it from its ends. Returns (points, closed).
 
     Inference uses the reader's closure test (``CLOSING_GAP_FACTOR`` mean edge lengths): a
     closed sampled curve joins up within about one edge, an open knot's tails are far apart.
     """
-    from tightknot.knots.centerline_io import CLOSING_GAP_FACTOR, read_centerline
+    from tightknot.knots.centerline_io import CLOSING_GAP_FACTOR, checked_points, read_raw
 
+    raw = read_raw(path, columns)
+    if closed is None and raw.closed is not None:
+        closed = raw.closed
     if closed is not None:
-        return read_centerline(path, units=factor, closed=closed), closed
-    pts = read_centerline(path, units=factor, closed=None)
+        return checked_points(raw, path, factor, closed), closed
+    pts = checked_points(raw, path, factor, None)
     n = pts.shape[0]
     edges = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     gap = float(np.linalg.norm(pts[-1] - pts[0]))
@@ -198,9 +231,26 @@ def read_points(path: str, factor: float, closed: bool | None) -> tuple[np.ndarr
     else:
         is_closed = gap <= CLOSING_GAP_FACTOR * float(edges.mean())
     if is_closed:
-        # Read again as closed: drops a repeated closing vertex, with the reader's checks.
-        pts = read_centerline(path, units=factor, closed=True)
+        # Checked again as closed: drops a repeated closing vertex, with the reader's checks.
+        pts = checked_points(raw, path, factor, True)
     return pts, is_closed
+
+
+def file_units(path: str, units: str | None, columns: tuple | None) -> tuple[float, str]:
+    """Metres per file unit and where that came from: ``--units`` when given (it must agree
+    with a unit the file's header names), else the header's unit, else metres."""
+    from tightknot.knots.centerline_io import HEADER_UNITS, read_raw
+
+    header = read_raw(path, columns).unit
+    if units is None:
+        if header is None:
+            return 1.0, "m (default: no --units, no unit in the header)"
+        return HEADER_UNITS[header], f"{header} (from the file's header)"
+    factor = parse_units(units)
+    if header is not None and not math.isclose(factor, HEADER_UNITS[header], rel_tol=1e-12):
+        raise _BadInput(f"--units {units}: the header of {path} gives {header}; drop --units "
+                        "or fix the header")
+    return factor, f"{units} (--units)"
 
 
 def json_safe(obj: Any) -> Any:
@@ -284,14 +334,18 @@ def run_analyze(args: argparse.Namespace) -> int:
     from tightknot.knots.measure import analyze_centerline
 
     try:
-        factor = _check_options(args)
+        _check_options(args)
+        factor, unit_source = file_units(args.file, args.units, args.columns)
+        _check_scaled(args, factor)
     except _BadInput as err:
         return _fail(str(err))
-    given = True if args.closed else (False if args.open else None)
-    try:
-        points, closed = read_points(args.file, factor, given)
     except CenterlineError as err:
         return _fail(str(err))  # already "<file>:<line>: <what>"
+    given = True if args.closed else (False if args.open else None)
+    try:
+        points, closed = read_points(args.file, factor, given, args.columns)
+    except CenterlineError as err:
+        return _fail(str(err))
     rest_length = None if args.rest_length is None else args.rest_length * factor
     if args.radii == "stretch" and rest_length is None:
         return _fail("--radii stretch needs --rest-length (the rod's length at rest)")
@@ -310,9 +364,12 @@ def run_analyze(args: argparse.Namespace) -> int:
                      f"{report['stretch_L_over_L0']:.3g} makes the reduced diameter D <= 0 "
                      "(check --units)")
     closed_source = "as given" if given is not None else "inferred from the file ends"
+    warnings = smoothing_warnings(report)
     report = json_safe(report)
     report["input"] = {"file": str(args.file), "units_m_per_file_unit": factor,
+                       "units": unit_source,
                        "closed_source": "option" if given is not None else "inferred"}
+    report["warnings"] = warnings
     if args.json is not None:
         write_json_atomic(args.json, report)
     written: list[Path] = []
@@ -321,6 +378,29 @@ def run_analyze(args: argparse.Namespace) -> int:
     if not args.quiet:
         print("\n".join(summary_lines(report, args.file, closed_source,
                                       args.rest_length is not None)))
+        print(f"  units              {unit_source}")
         for path in ([Path(args.json)] if args.json else []) + written:
             print(f"  wrote {path}")
+    for warning in warnings:
+        print(f"tightknot analyze: warning: {warning}", file=sys.stderr)
     return EXIT_OK
+
+
+#: Relative length change by smoothing worth a warning: the 4th decimal of the printed
+#: stretch L/L0 (smaller changes do not show in the summary).
+SMOOTHING_LENGTH_TOL = 1e-4
+
+
+def smoothing_warnings(report: Mapping[str, Any]) -> list[str]:
+    """A warning when the study's smoothing shortened an open curve: its truncated window
+    pulls each end inward along its tail (tightknot.knots.smoothing, "Ends of an open
+    curve"), so length, stretch and L/D come out low by that much, noise or none."""
+    if not report.get("smoothed") or report["closed"]:
+        return []
+    before, after = report["length_before_smoothing"], report["length_L"]
+    change = (after - before) / before
+    if abs(change) <= SMOOTHING_LENGTH_TOL:
+        return []
+    return [f"--smooth changed the open curve's length by {100 * change:+.2f} % (the "
+            "study's truncated window pulls each end inward along its tail), so stretch "
+            "and L/D are biased by as much; measure them without --smooth"]

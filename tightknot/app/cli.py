@@ -126,7 +126,8 @@ def _cmd_tie(args: argparse.Namespace) -> int:
 
     cfg = tie_config(args)
     # Every output path is checked before any work (issue 6: fail early, not after minutes).
-    outs = plan_outputs(cfg.scene_name, args.out, args.json, args.rrd, args.figures)
+    outs = plan_outputs(cfg.scene_name, args.out, args.json, args.rrd, args.figures,
+                        overwrite=args.overwrite)
     # The device actually used goes into config.json (None would mean "cpu" here but
     # perhaps not in a later version): the file records what ran.
     cfg = dataclasses.replace(cfg, device=resolve_device(cfg.device))
@@ -160,12 +161,10 @@ def _cmd_tie(args: argparse.Namespace) -> int:
         for k in keys:
             if k in summary:
                 print(f"  {k:28s} {summary[k]}")
-        print(f"wrote {outs.folder}/ ({outs.config.name}, {outs.centerline.name})")
-        for path in (outs.summary, outs.rrd, *figures):
-            if outs.folder not in path.parents:
-                print(f"wrote {path}")
+        print(written_outputs(outs, figures))
         print(f"look at it: tightknot view {outs.rrd}")
-    for warning in summary.get("warnings", []):
+    coarse = (summary.get("resolution") or {}).get("warning")
+    for warning in [*summary.get("warnings", []), *([coarse] if coarse else [])]:
         print(f"tightknot tie: warning: {warning}", file=sys.stderr)
     if not run.result.converged:
         print(f"tightknot tie: failed: {run.result.failure} (after {summary['load_steps']} "
@@ -173,6 +172,22 @@ def _cmd_tie(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return EXIT_PHYSICS
     return EXIT_OK
+
+
+def written_outputs(outs, figures: list[Path]) -> str:
+    """What a tie wrote: the run folder's files by name (figures under their folder), and
+    any output sent elsewhere by its path."""
+    inside, outside = [], []
+    for path in (outs.config, outs.summary, outs.centerline, outs.rrd):
+        (inside if path.parent == outs.folder else outside).append(path)
+    figs = ", ".join(p.name for p in figures)
+    lines = [f"wrote {outs.folder}/ ({', '.join(p.name for p in inside)}"
+             + (f", {outs.figures.name}/: {figs})" if outs.figures.parent == outs.folder
+                else ")")]
+    lines += [f"wrote {p}" for p in outside]
+    if outs.figures.parent != outs.folder:
+        lines.append(f"wrote {outs.figures}/ ({figs})")
+    return "\n".join(lines)
 
 
 # -- view ------------------------------------------------------------------------------------
@@ -246,21 +261,32 @@ def _cmd_view(args: argparse.Namespace) -> int:
 _DEMO_EXAMPLES = """examples:
   tightknot demo                 # writes runs/demo/
   tightknot demo --out /tmp/tk
+  tightknot demo --overwrite     # run again into runs/demo/
+
+"passed" in summary.json: every knot's load path converged (each load step's Newton solve
+met its tolerance, the knot type never changed, an open knot reached its target Lambda_OC
+within its tolerance). It says nothing about the accuracy of the coarse meshes: each knot's
+"resolution" entry gives the expected error of its vertex count (README, speed vs accuracy).
 """
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     from tightknot.app.demo import run_demo
-    from tightknot.app.run_folder import check_output_dir, in_runs_tree
 
     # Checked before the run: a folder under runs/ (the default runs/demo) is made with its
     # parents, any other only under an existing parent (a missing parent is likely a typo).
+    from tightknot.app.run_folder import check_output_dir, in_runs_tree, refuse_existing
+
     out = Path(args.out)
     check_output_dir(out, "--out", parents=in_runs_tree(out))
+    if not args.overwrite:
+        refuse_existing([out / "summary.json", out / "demo.rrd", out / "figures"],
+                        "--overwrite")
     summary = run_demo(out, quiet=args.quiet)
     if not args.quiet:
         print(json.dumps(summary, indent=2))
-        print(f"wrote {out}/ (summary.json, figures/, demo.rrd)")
+        figures = ", ".join(sorted(p.name for p in (out / "figures").glob("*.png")))
+        print(f"wrote {out}/ (summary.json, demo.rrd, figures/: {figures})")
     return EXIT_OK if summary.get("passed", False) else EXIT_PHYSICS
 
 
@@ -323,6 +349,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="FILE", help="write the summary here instead")
     p.add_argument("--figures", metavar="DIR", help="write the figures here instead")
     p.add_argument("--rrd", metavar="FILE", help="write the rerun log here instead")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the outputs of an earlier run in --out (refused without it)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_tie)
 
@@ -332,6 +360,8 @@ def build_parser() -> argparse.ArgumentParser:
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", default="runs/demo", metavar="DIR",
                    help="output folder (default runs/demo; created)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the outputs of an earlier demo in --out (refused without it)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(handler=_cmd_demo)
 
@@ -354,6 +384,9 @@ def build_parser() -> argparse.ArgumentParser:
     register_fem(sub)
     register_bench(sub)
     register_sweep(sub)
+    from tightknot.app.sweep_outputs import register as register_sweep_outputs
+
+    register_sweep_outputs(sub)
     return parser
 
 

@@ -101,6 +101,10 @@ class RunOutputs:
     rrd: Path
     figures: Path
 
+    def files(self) -> list[Path]:
+        """Every output, in the order a run writes them (the figures folder last)."""
+        return [self.config, self.summary, self.centerline, self.rrd, self.figures]
+
     def create(self) -> None:
         """Make the run folder (and the default tree above it); the figures folder is
         made by the figure writer."""
@@ -108,12 +112,14 @@ class RunOutputs:
 
 
 def plan_outputs(scene_name: str, out: str | None = None, json: str | None = None,
-                 rrd: str | None = None, figures: str | None = None) -> RunOutputs:
+                 rrd: str | None = None, figures: str | None = None,
+                 overwrite: bool = False) -> RunOutputs:
     """Resolve and check every output path of a run before it starts (ValueError if bad).
 
     ``out`` None: :func:`default_run_dir`. A folder under ``runs/`` is made with its parents;
     any other may be new but its parent must exist (a missing parent is a typo more often
-    than a wish).
+    than a wish). An output that exists already (a file, or a figures folder with files in
+    it) is refused unless ``overwrite``: a rerun must not replace a run without being asked.
     """
     folder = Path(out) if out is not None else default_run_dir(scene_name)
     check_output_dir(folder, "--out", parents=in_runs_tree(folder))
@@ -129,8 +135,21 @@ def plan_outputs(scene_name: str, out: str | None = None, json: str | None = Non
         check_output_file(rrd_path, "--rrd")
     if figures is not None:
         check_output_dir(figs, "--figures")
-    return RunOutputs(folder, summary, folder / CONFIG_JSON, folder / CENTERLINE_CSV,
+    outs = RunOutputs(folder, summary, folder / CONFIG_JSON, folder / CENTERLINE_CSV,
                       rrd_path, figs)
+    if not overwrite:
+        refuse_existing(outs.files(), "--overwrite")
+    return outs
+
+
+def refuse_existing(paths: list[Path], flag: str) -> None:
+    """ValueError naming the outputs in ``paths`` that exist already (a figures folder
+    counts when it holds a file), and the ``flag`` that allows replacing them."""
+    taken = [p for p in paths if p.is_file() or (p.is_dir() and any(p.iterdir()))]
+    if taken:
+        names = ", ".join(str(p) for p in taken)
+        raise ValueError(f"{names}: already written by an earlier run; give {flag} to "
+                         "replace it, or choose another output")
 
 
 def write_centerline(path: Path, x: np.ndarray, scene_name: str, diameter: float,

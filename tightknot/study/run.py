@@ -24,6 +24,7 @@ from tightknot.loading.pull import tie_to_lambda
 from tightknot.loading.refine import tie_refined
 from tightknot.loading.tie import TieResult, end_reaction, tie
 from tightknot.solvers.system import RodSystem
+from tightknot.study.resolution import resolution_note
 from tightknot.viz.rerun_log import ROD_FIELDS
 
 #: Contact tolerance of the measurements (the default of tightknot.knots.measure).
@@ -78,10 +79,12 @@ def check_color_field(name: str) -> str:
 
 
 def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
-              color_by: str = "kappa_D0") -> None:
+              color_by: str = "kappa_D0", phase: str | None = None) -> None:
     """Log the rod (tube coloured by ``color_by``, deformed radii) and its contact pairs
     (coloured by peak p/E) at the logger's current step; open knots also get their
-    end-to-end distance [m], pulling force [N] and Lambda_OC [1] (when in contact)."""
+    end-to-end distance [m], pulling force [N] and Lambda_OC [1] (when in contact), under
+    ``name/<phase>/`` when the load ``phase`` is given ("tighten", "pull", ...), so that
+    the tightening's end reaction and the pull's force are separate series."""
     x = system.state.x
     r_e, r_v = vertex_radii(scene, x, system.rest)
     rep = contact_report(scene.contact, x)
@@ -94,12 +97,23 @@ def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
     if not scene.closed:
         # The force the pulled end carries (its reaction: the dead load of a force-driven
         # pull, what holds a moved end where it is otherwise) [N].
-        scalars = {f"{name}/end_to_end": float(np.linalg.norm(x[-1] - x[0])),
-                   f"{name}/pulling_force": end_reaction(system)}
+        where = f"{name}/{phase}" if phase else name
+        scalars = {f"{where}/end_to_end": float(np.linalg.norm(x[-1] - x[0])),
+                   f"{where}/pulling_force": end_reaction(system)}
         lam = lambda_oc(x, scene.diameter, r_v, tol=CONTACT_TOL)
         if np.isfinite(lam):
-            scalars[f"{name}/lambda_oc"] = lam
+            scalars[f"{where}/lambda_oc"] = lam
         log.log_scalars(scalars)
+
+
+def pull_point(scene: KnotScene, system: RodSystem) -> tuple[float, float, float | None]:
+    """One point of an open knot's force-extension curve: the force on the pulled end [N],
+    the end-to-end distance [m] and Lambda_OC (None without contact)."""
+    x = system.state.x
+    _, r_v = vertex_radii(scene, x, system.rest)
+    lam = lambda_oc(x, scene.diameter, r_v, tol=CONTACT_TOL)
+    return (end_reaction(system), float(np.linalg.norm(x[-1] - x[0])),
+            float(lam) if np.isfinite(lam) else None)
 
 
 def logging_hook(log: Any, scene: KnotScene, name: str, counter: list[int],
@@ -116,9 +130,11 @@ def logging_hook(log: Any, scene: KnotScene, name: str, counter: list[int],
     def hook(phase: str, system: RodSystem, rec: Any) -> None:
         step = counter[0]
         counter[0] += 1
+        if logged is not None:
+            logged["phase"] = phase
         if log is not None:
             log.set_step(step, rec.t)
-            log_state(log, scene, name, system, color_by)
+            log_state(log, scene, name, system, color_by, phase)
             sp = system.last_split
             log.log_scalars({
                 f"{name}/energy/stretch": sp.stretch, f"{name}/energy/bend": sp.bend,
@@ -155,9 +171,12 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         # No pair within the interaction range (a knot that came undone): no gap to report
         # (JSON has no infinity).
         "min_gap_over_D0": dmin / scene.diameter if math.isfinite(dmin) else None,
-        "max_pressure_over_E": float(np.max(contact.peak_pressure_over_E)),
+        # A rigid tube reports no pressure and no width (contact_report): null, not 0.
+        "max_pressure_over_E": (None if scene.contact.law.rigid
+                                else float(np.max(contact.peak_pressure_over_E))),
         "min_area_ratio": float(np.min(contact.area_ratio)),
-        "max_contact_width_fraction": float(np.max(contact.contact_width_fraction)),
+        "max_contact_width_fraction": (None if scene.contact.law.rigid
+                                       else float(np.max(contact.contact_width_fraction))),
         "kappa_D0_max": rep["kappa_D0_max"],
         "kappa_D0_min": rep["kappa_D0_min"],
         "s": s.tolist(),
@@ -222,10 +241,13 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
     # Always hooked: the hook numbers the steps on the timeline and reports progress.
     inner = logging_hook(log, scene, name, counter, color_by, progress, logged)
     calls = [0]
+    pulled: list[tuple[float, float, float | None]] = []
 
     def hook(phase: str, system: RodSystem, rec: Any) -> None:
         calls[0] += 1
         inner(phase, system, rec)
+        if phase == "pull" and not scene.closed:
+            pulled.append(pull_point(scene, system))
 
     target = tie_options.pop("target_lambda", None)
     coarse = tie_options.pop("coarse_nodes", None)
@@ -241,8 +263,15 @@ def run_knot(scene: KnotScene, log: Any | None = None, name: str | None = None,
     if log is not None and not np.array_equal(logged.get("x"), x):
         log.set_step(counter[0])
         counter[0] += 1
-        log_state(log, scene, name, res.system, color_by)
-    return measure_run(scene, res, calls[0])
+        log_state(log, scene, name, res.system, color_by, logged.get("phase"))
+    run = measure_run(scene, res, calls[0])
+    if not scene.closed:
+        # The pull's own force-extension data, in the order its equilibria were reached (a
+        # search for a Lambda_OC brackets its target, so the force need not grow).
+        run.summary["pull_series"] = {"pull_force_N": [p[0] for p in pulled],
+                                      "end_to_end_m": [p[1] for p in pulled],
+                                      "lambda_oc": [p[2] for p in pulled]}
+    return run
 
 
 def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
@@ -259,6 +288,9 @@ def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
     contact = contact_report(scene.contact, x, res.system.rest)
     summary = summarise(scene, res, rep, contact)
     summary["load_steps"] = load_steps
+    # What the mesh costs in accuracy, so a coarse run says so (the trade-off study's numbers);
+    # its warning stays in this entry: "warnings" are about the contact law's validity.
+    summary["resolution"] = resolution_note(scene.closed, scene.model.vertex_count)
     return KnotRun(scene, res, rep, contact, summary)
 
 

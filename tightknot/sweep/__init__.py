@@ -11,6 +11,8 @@
 * :mod:`~tightknot.sweep.store`: one atomically written JSON file per case, plus an index.
 * :mod:`~tightknot.sweep.executors`: serial, local processes (spawned), Dask distributed.
 * :mod:`~tightknot.sweep.sweep`: :func:`run_sweep`, which skips what a store has finished.
+* :mod:`~tightknot.sweep.table`: a store as one flat table, a row per case and level
+  (:func:`table_rows`, :func:`to_dataframe`, :func:`write_table`).
 * :mod:`~tightknot.sweep.commands`: ``tightknot sweep``.
 
 Example::
@@ -26,8 +28,10 @@ from tightknot.sweep.execute import physics, run_case
 from tightknot.sweep.executors import DaskExecutor, SerialExecutor, make_executor
 from tightknot.sweep.store import Store, StoreError
 from tightknot.sweep.sweep import SweepReport, run_sweep
+from tightknot.sweep.table import table_rows, to_dataframe, write_table
 
 __all__ = [
     "Case", "DaskExecutor", "SerialExecutor", "Store", "StoreError", "SweepReport",
     "canonical", "case_id", "grid", "make_executor", "physics", "run_case", "run_sweep",
+    "table_rows", "to_dataframe", "write_table",
 ]

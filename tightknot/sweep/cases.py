@@ -159,16 +159,15 @@ class Case:
         return []
 
     def label(self) -> str:
-        """Short human label: the knot and the parameters that differ from the defaults."""
-        base = defaults(self.params["knot"], self.params["knot_type"])
+        """Human label naming every parameter that defines the case, defaults included
+        (a label that leaves them out reads the same for two different rods): the knot,
+        then ``key=value`` in the canonical order, a level list in full."""
         parts = [self.params["knot"]]
-        if self.params["knot_type"] != "3_1":
-            parts.append(self.params["knot_type"])
         for k, v in self.params.items():
-            if k in ("knot", "knot_type") or (k in base and base[k] == v):
+            if k == "knot":
                 continue
             if isinstance(v, list):
-                parts.append(f"{k}={len(v)} levels")
+                parts.append(f"{k}=[{', '.join(f'{x:g}' for x in v)}]")
             else:
                 parts.append(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}")
         return " ".join(parts)

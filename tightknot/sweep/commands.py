@@ -4,7 +4,10 @@ Every option that takes several values is a sweep axis (the cases are their Cart
 product); an open knot's ``--lambda`` or ``--force`` levels are one continuation path per
 case (tie once, then pull level by level). Results go to ``--out DIR`` (one JSON file per
 case, plus ``index.json``); running the same command again skips the finished cases.
-Exit codes: 0 every case ok, 1 a case failed (its reason printed), 2 bad input.
+Exit codes: 0 every case ok, 1 a case failed (its reason printed), 2 bad input. An open
+knot's path that reached some of its levels is ok: every reached level is kept, each missed
+one is marked (``reached: false``) and printed as a warning on stderr, and the exit code
+stays 0; a path that reached none of them (or whose tie failed) is a failed case.
 """
 
 from __future__ import annotations
@@ -35,6 +38,10 @@ _EXAMPLES = """examples:
 
 store: DIR/index.json lists every case (id, params, status); DIR/cases/ID.json holds its
 record (the knot summary of 'tightknot tie'; for an open knot one entry per level).
+Flat table and plots of a store: tightknot table DIR --out t.csv; tightknot plot DIR.
+
+exit codes: 0 every case ok (a level an open knot's path missed is a warning: the others
+are kept), 1 a case failed (a tie that failed, or a path that reached no level), 2 bad input.
 """
 
 
@@ -129,6 +136,7 @@ def build_cases(args: argparse.Namespace) -> list:
 def short_result(record: dict[str, Any]) -> dict[str, Any]:
     """A record's headline numbers (no profiles) for the --json summary."""
     out = {k: record[k] for k in ("id", "params", "status", "failure", "wall_time_s")}
+    out["warnings"] = record.get("warnings", [])
     res = record.get("result") or {}
     if "table" in res:
         out["levels"] = res["table"]
@@ -217,6 +225,10 @@ def run_command(args: argparse.Namespace) -> int:
             "store": str(store.folder), "cases": [short_result(r) for r in records],
             "ran": report.ran, "skipped": report.skipped,
             "failed": report.failed, "wall_time_s": report.wall_time_s})
+    for r in records:
+        for warning in r.get("warnings", []):
+            print(f"tightknot sweep: warning: case {r['id']} ({labels.get(r['id'], '')}): "
+                  f"{warning}", file=sys.stderr)
     if report.failed:
         for r in records:
             if r["id"] in report.failed:

@@ -71,8 +71,14 @@ def solve_case(case: Case, device: str = "cpu") -> dict[str, Any]:
     }
     for row in result["table"]:
         row.pop("wall_time_s", None)  # timings live in "levels"; the table is the physics
-    return {"status": OK if path.converged else FAILED, "failure": path.failure,
-            "result": result}
+    # A level the path could not reach does not undo the others: the case is ok when the
+    # tie held and some level was reached, each missed level a warning.
+    reached = any(lv.reached for lv in path.levels)
+    missed = [f"level {lv.kind} = {lv.target:g} not reached: {lv.failure}"
+              for lv in path.levels if not lv.reached]
+    ok = path.converged or reached
+    return {"status": OK if ok else FAILED, "failure": "" if ok else path.failure,
+            "warnings": missed, "result": result}
 
 
 def run_case(params: Mapping[str, Any], device: str = "cpu") -> dict[str, Any]:
@@ -88,6 +94,7 @@ def run_case(params: Mapping[str, Any], device: str = "cpu") -> dict[str, Any]:
     except Exception as err:  # noqa: BLE001 (one case's crash must not stop the sweep)
         tb = traceback.format_exception_only(type(err), err)[-1].strip()
         out = {"status": ERROR, "failure": tb, "result": None}
+    out.setdefault("warnings", [])
     return {"id": case.id, "params": case.params, **out,
             "wall_time_s": time.perf_counter() - start,
             "host": platform.node(), "pid": os.getpid()}
@@ -138,7 +145,7 @@ def _solve_batch(cases: list[Case], device: str) -> list[dict[str, Any]]:
         steps = sum(len(ph.steps) for ph in rod.phases.values())
         run = measure_run(sc, res, steps)
         outs.append({"status": OK if rod.converged else FAILED, "failure": rod.failure,
-                     "result": run.summary})
+                     "warnings": [], "result": run.summary})
     return outs
 
 
