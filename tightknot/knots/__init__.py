@@ -5,7 +5,9 @@ Pure functions of numpy arrays (SI units inside; non-dimensional numbers only in
 outputs, named so). Modules:
 
 - ``topology``: ``alexander_polynomial``, ``alexander_at_minus1``, ``knot_type``,
-  ``close_open_curve``.
+  ``close_open_curve``. ``knot_table``: ``knot_name``, ``candidates`` (the Alexander
+  polynomials of the knots through 8 crossings).
+- ``families``: ``torus_knot`` (parametric start curves).
 - ``curves``: ``trefoil``, ``figure_eight``, ``open_trefoil``, ``open_figure_eight``,
   ``circle``, ``helix``, ``resample_uniform``, ``exclusion_arc_length``,
   ``min_nonlocal_distance``, ``scale_for_diameter``, ``check_no_overlap``.
