@@ -13,7 +13,7 @@ import pytest
 from tightknot.app.cli import build_parser, tie_config
 from tightknot.app.config import config_from_dict, config_keys
 from tightknot.knots.scenes import default_nodes
-from tightknot.loading.options import LoadPath, Range, flag, parameters
+from tightknot.loading.options import LoadPath, Range, flags, parameters
 from tightknot.study.params import (
     CONTACT_LEVELS,
     KNOT_DEFAULTS,
@@ -56,7 +56,7 @@ def test_every_run_parameter_is_a_config_key_and_a_tie_flag() -> None:
             assert not knot.option_strings and list(knot.choices) == list(p.valid)
             continue
         action = opts[name]
-        assert action.option_strings == [flag(name)] and action.default is None, name
+        assert action.option_strings == list(flags(p)) and action.default is None, name
         if isinstance(p.valid, tuple) and p.kind is str:
             assert list(action.choices) == list(p.valid) + list(p.aliases), name
 
@@ -145,8 +145,13 @@ def test_the_scene_defaults_are_the_scenes_own() -> None:
     assert CONTACT_LEVELS == tuple(c for c in scenes.CONTACT_LEVELS if c != "off")
     names = {"3_1": "trefoil", "4_1": "figure_eight"}
     for (knot, knot_type), table in KNOT_DEFAULTS.items():
-        sig = inspect.signature(getattr(scenes, f"{knot}_{names[knot_type]}")).parameters
-        length = sig["l0_over_d0" if knot == "closed" else "rest_length"].default
+        if knot_type in names:
+            sig = inspect.signature(getattr(scenes, f"{knot}_{names[knot_type]}")).parameters
+            length = sig["l0_over_d0" if knot == "closed" else "rest_length"].default
+        else:
+            sig = inspect.signature(getattr(scenes, f"{knot}_knot")).parameters
+            length = (scenes.default_l0_over_d0 if knot == "closed"
+                      else scenes.default_open_length)(knot_type)
         assert table["l0_over_d0" if knot == "closed" else "length"] == length
         assert table["twist"] == sig["twist"].default
         assert sig["nodes"].default is None  # both resolve it from the rest length

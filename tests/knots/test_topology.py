@@ -46,12 +46,12 @@ def test_trefoil_figure_eight_and_mirror():
     assert knot_type(fig8) == "4_1"
 
 
-def test_cinquefoil_is_reported_unknown():
+def test_cinquefoil_is_named():
     # The (2,5) torus knot 5_1 has Delta = t^4 - t^3 + t^2 - t + 1, determinant 5 like 4_1:
     # the polynomial, not the determinant, must separate them.
     pts = torus_knot(2, 5, 800)
     assert alexander_polynomial(pts) == [1, -1, 1, -1, 1]
-    assert knot_type(pts) == "unknown(det=5)"
+    assert knot_type(pts) == "5_1"
 
 
 @pytest.mark.parametrize("maker,expected", [(curves.trefoil, 3), (curves.figure_eight, 5)])

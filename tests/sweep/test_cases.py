@@ -86,8 +86,12 @@ def test_knot_types_have_their_own_default_lengths() -> None:
     assert Case.of({"knot": "closed", "knot_type": "4_1"}).params["l0_over_d0"] == 22.1
     assert Case.of({"knot": "open", "knot_type": "4_1", "pull_force": [2]}).params["length"] \
         == 0.30
-    with pytest.raises(ValueError, match="knot_type: '5_1' is not one of"):
-        Case.of({"knot": "closed", "knot_type": "5_1"})
+    from tightknot.knots.scenes import default_l0_over_d0
+
+    assert Case.of({"knot": "closed", "knot_type": "5_1"}).params["l0_over_d0"] == \
+        default_l0_over_d0("5_1")
+    with pytest.raises(ValueError, match="knot_type: '9_1' is not one of"):
+        Case.of({"knot": "closed", "knot_type": "9_1"})
 
 
 def test_a_case_builds_the_scene_it_names() -> None:

@@ -73,6 +73,8 @@ _TIE_EXAMPLES = """examples:
   tightknot tie open --length 0.125 --target-lambda 10.1 --out runs/tight
   tightknot tie open --length 0.185 --force 5 --json open.json
   tightknot tie closed --knot-type 4_1 --out runs/eight  # the figure-eight knot
+  tightknot tie closed --knot 5_1                        # any built-in knot (--knot-type)
+  tightknot tie open --knot 5_2 --force 1
   tightknot tie --config runs/tight/config.json --out runs/tight-again   # rerun a run
   tightknot tie --config runs/tight/config.json --nodes 400              # ... with a change
 
@@ -323,7 +325,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(handler=_cmd_verify)
 
     from tightknot.app.config import TieConfig, config_keys
-    from tightknot.loading.options import flag, flag_kwargs, parameters
+    from tightknot.loading.options import flag_kwargs, flags, parameters
 
     p = sub.add_parser("tie", help="tie and tighten the study's knots, measure them",
                        description="Tie a closed knot (rest length L0 = l0/d0 D0) or an "
@@ -343,7 +345,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="parameters from a run folder's config.json (or TOML); flags override")
     for name, par in params.items():
         if name != "knot":
-            p.add_argument(flag(name), **flag_kwargs(par))
+            p.add_argument(*flags(par), **flag_kwargs(par))
     p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>; "
                    "made with its parents under runs/, elsewhere its parent must exist)")
     p.add_argument("--json", metavar="FILE", help="write the summary here instead")

@@ -5,7 +5,10 @@ Pure functions of numpy arrays (SI units inside; non-dimensional numbers only in
 outputs, named so). Modules:
 
 - ``topology``: ``alexander_polynomial``, ``alexander_at_minus1``, ``knot_type``,
-  ``close_open_curve``.
+  ``close_open_curve``. ``knot_table``: ``knot_name``, ``candidates`` (the Alexander
+  polynomials of the knots through 8 crossings).
+- ``families``: ``torus_knot``, ``twist_knot`` (parametric start curves). ``catalogue``:
+  the built-in knots (``BUILTIN_KNOTS``, ``open_curve``, ``ideal_l_over_d``).
 - ``curves``: ``trefoil``, ``figure_eight``, ``open_trefoil``, ``open_figure_eight``,
   ``circle``, ``helix``, ``resample_uniform``, ``exclusion_arc_length``,
   ``min_nonlocal_distance``, ``scale_for_diameter``, ``check_no_overlap``.
@@ -52,4 +55,6 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "open_trefoil": ".scenes",
     "closed_figure_eight": ".scenes",
     "open_figure_eight": ".scenes",
+    "closed_knot": ".scenes",
+    "open_knot": ".scenes",
 })

@@ -19,6 +19,7 @@ from tightknot.knots.closed_measures import closed_knot_profile
 from tightknot.knots.contact_map import contact_pairs, double_contact_fraction
 from tightknot.knots.curvature import bergou_curvature, find_spikes
 from tightknot.knots.curves import exclusion_arc_length, min_nonlocal_distance, resample_uniform
+from tightknot.knots.knot_table import determinant, knot_name
 from tightknot.knots.open_measures import contact_gaps
 from tightknot.knots.smoothing import study_smooth, study_window
 from tightknot.knots.topology import (
@@ -106,11 +107,8 @@ def analyze_centerline(
     # Knot type: an open curve is closed far away along its end-to-end axis first.
     try:
         poly = alexander_polynomial(p if closed else close_open_curve(p))
-        from tightknot.knots.topology import _KNOWN
-
-        det = abs(sum(c * (-1) ** k for k, c in enumerate(poly)))
-        out.update(alexander_polynomial=poly, knot_determinant=det,
-                   knot_type=_KNOWN.get(tuple(poly), f"unknown(det={det})"))
+        out.update(alexander_polynomial=poly, knot_determinant=determinant(poly),
+                   knot_type=knot_name(poly))
     except TopologyError as exc:
         out.update(alexander_polynomial=None, knot_determinant=None,
                    knot_type=f"undetermined: {exc}")

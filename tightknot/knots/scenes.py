@@ -62,6 +62,8 @@ import numpy as np
 from tightknot.contact.law import RadialComplianceLaw
 from tightknot.contact.layer import ContactLayer
 from tightknot.knots import curves
+from tightknot.knots.catalogue import IDEAL_L_OVER_D as IDEAL_L_OVER_D  # the scenes' name
+from tightknot.knots.catalogue import builtin, ideal_l_over_d, open_curve
 from tightknot.knots.smoothing import gaussian_smooth_points
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
@@ -98,9 +100,6 @@ GRIP_TWIST = ("free", "clamped")
 #: the trade-off study (README) gives the accuracy a resolution buys.
 DEFAULT_EDGE_D0 = 0.07
 
-#: Length over diameter of the ideal (tightest rigid-tube) closed knots: trefoil 16.3715
-#: (Przybyl & Pieranski 2014), figure-eight 21.0415 (Ashton, Cantarella, Piatek, Rawdon 2011).
-IDEAL_L_OVER_D = {"3_1": 16.3715, "4_1": 21.0415}
 
 #: Default L0/D0 of the closed figure-eight: 5 % above its ideal 21.04. The trefoil is tied
 #: at its ideal value (the study's choice, the rod then stretches ~7 %); the figure-eight is
@@ -275,10 +274,11 @@ def _check_ratio(l0_over_d0: float, knot_type: str) -> float:
     ratio = check_positive("l0_over_d0", l0_over_d0, "")
     # 0.61 of the ideal value (10 for the trefoil): far below it the rod would have to
     # stretch by more than half to close, outside any meaningful regime.
-    low = round(0.61 * IDEAL_L_OVER_D[knot_type])
+    ideal, known = ideal_l_over_d(knot_type)
+    low = round(0.61 * ideal)
     if ratio < low:
         raise ValueError(f"l0_over_d0 must be >= {low} (the ideal {knot_type} needs "
-                         f"{IDEAL_L_OVER_D[knot_type]:.2f}), got {l0_over_d0!r}")
+                         f"{ideal:.2f}{'' if known else ', estimated'}), got {l0_over_d0!r}")
     return ratio
 
 
@@ -481,6 +481,109 @@ def open_figure_eight(
                                                 twist, device, tail_fraction, clearance,
                                                 contact, grip_length, grip_twist)
     return scene
+
+
+def closed_knot(
+    knot_type: str,
+    l0_over_d0: float | None = None,
+    diameter: float = STUDY_DIAMETER,
+    nodes: int | None = None,
+    material: Material | None = None,
+    law: RadialComplianceLaw | None = None,
+    twist: bool = True,
+    device: str = "cpu",
+    clearance: float = 1.02,
+    contact: str = "compliant",
+) -> KnotScene:
+    """A closed knot of any built-in type (:mod:`tightknot.knots.catalogue`) of rest length
+    L0 = ``l0_over_d0`` D0 (default :func:`default_l0_over_d0`), joined with no excess twist,
+    no external load: the trefoil and figure-eight are :func:`closed_trefoil` and
+    :func:`closed_figure_eight`, the others the same scene from their own start curve."""
+    l0_over_d0 = default_l0_over_d0(knot_type) if l0_over_d0 is None else l0_over_d0
+    if knot_type == "3_1":
+        return closed_trefoil(l0_over_d0, diameter, nodes, material, law, twist, device,
+                              clearance, contact)
+    if knot_type == "4_1":
+        return closed_figure_eight(l0_over_d0, diameter, nodes, material, law, twist, device,
+                                   clearance, contact)
+    knot = builtin(knot_type)
+    ratio = _check_ratio(l0_over_d0, knot_type)
+    nodes = default_nodes(ratio, True) if nodes is None else nodes
+    d0 = _check_common(diameter, nodes, 32)
+    twist, contact = check_twist(twist), check_contact(contact, law)
+    scene = _closed_knot(f"closed_{knot_type}", knot_type, knot.curve(4000), ratio, d0, nodes,
+                         material, law, twist, contact, device, clearance)
+    scene.rebuild = lambda n: closed_knot(knot_type, l0_over_d0, diameter, n, material, law,
+                                          twist, device, clearance, contact)
+    return scene
+
+
+def open_knot(
+    knot_type: str,
+    rest_length: float | None = None,
+    diameter: float = STUDY_DIAMETER,
+    nodes: int | None = None,
+    material: Material | None = None,
+    law: RadialComplianceLaw | None = None,
+    twist: bool = False,
+    device: str = "cpu",
+    tail_fraction: float = 0.2,
+    clearance: float = 1.02,
+    contact: str = "compliant",
+    grip_length: float = GRIP_LENGTH,
+    grip_twist: str = "free",
+) -> KnotScene:
+    """An open knot of any built-in type of rest length L0 (default
+    :func:`default_open_length`) with straight tails along the x axis, built, held and pulled
+    like :func:`open_trefoil`: the trefoil and figure-eight are :func:`open_trefoil` and
+    :func:`open_figure_eight`, the others cut from their closed start curve
+    (:func:`tightknot.knots.catalogue.open_curve`)."""
+    rest_length = default_open_length(knot_type) if rest_length is None else rest_length
+    if knot_type == "3_1":
+        return open_trefoil(rest_length, diameter, nodes, material, law, twist, device,
+                            tail_fraction, clearance, contact, grip_length, grip_twist)
+    if knot_type == "4_1":
+        return open_figure_eight(rest_length, diameter, nodes, material, law, twist, device,
+                                 tail_fraction, clearance, contact, grip_length, grip_twist)
+    builtin(knot_type)
+
+    def curve_fn(n: int, size: float, tail: float) -> np.ndarray:
+        return open_curve(knot_type, n, size, tail)
+
+    # Tail corners rounded as the figure-eight's (std 2 units within 5 units of them): the
+    # start curves of these knots have its size (a tube diameter of about one unit).
+    scene = _open_knot(f"open_{knot_type}", knot_type, curve_fn, rest_length, diameter,
+                       nodes, material, law, twist, contact, device, tail_fraction,
+                       clearance, corner_std=2.0, grip_length=grip_length,
+                       grip_twist=grip_twist, corner_window=5.0)
+    scene.rebuild = lambda n: open_knot(knot_type, rest_length, diameter, n, material, law,
+                                        twist, device, tail_fraction, clearance, contact,
+                                        grip_length, grip_twist)
+    return scene
+
+
+def default_l0_over_d0(knot_type: str) -> float:
+    """Default L0/D0 of a closed knot: the study's 16.37 for the trefoil, and for the others
+    5 % above the ideal L/D (:func:`tightknot.knots.catalogue.ideal_l_over_d`, known or
+    estimated), rounded up to 0.1, as the figure-eight's 22.1: reachable by a rod that
+    stretches and squeezes a little, as the trefoil's does at its ideal length."""
+    if knot_type == "3_1":
+        return 16.37
+    builtin(knot_type)
+    return math.ceil(10.0 * 1.05 * ideal_l_over_d(knot_type)[0] - 1e-9) / 10.0
+
+
+def default_open_length(knot_type: str, diameter: float = STUDY_DIAMETER) -> float:
+    """Default rest length [m] of an open knot: the study's 185 mm for the trefoil, 0.30 m
+    for the figure-eight, and for the others 1.6 times the closed knot's default L0 (the
+    figure-eight's proportion: the knot plus tails that stay long while it tightens),
+    rounded up to 5 mm, for a rod of ``diameter`` [m]."""
+    if knot_type == "3_1":
+        return 0.185
+    if knot_type == "4_1":
+        return 0.30
+    length = 1.6 * default_l0_over_d0(knot_type) * diameter
+    return math.ceil(length / 0.005 - 1e-9) * 0.005
 
 
 def gauge(scene: KnotScene, positions: np.ndarray | None = None,

@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from tightknot.knots._arclength import as_points
+from tightknot.knots.knot_table import knot_name
 
 # A crossing closer than this fraction of an edge to a vertex makes the projection ambiguous
 # (the crossing could belong to either edge after round-off): reject the projection.
@@ -295,21 +296,13 @@ def alexander_polynomial(points: ArrayLike, seed: int = 0, tries: int = 20) -> l
     return coeffs
 
 
-_KNOWN = {(1,): "0_1", (1, -1, 1): "3_1", (1, -3, 1): "4_1"}
-
-
 def knot_type(points: ArrayLike, seed: int = 0) -> str:
-    """Knot type of a closed polygon: "0_1", "3_1", "4_1" or "unknown(det=..)".
-
-    Decided by the Alexander polynomial, which separates these three knots (it does not
-    separate all knots: e.g. some knots with Delta = 1 exist, so "0_1" means Delta = 1).
-    """
-    poly = alexander_polynomial(points, seed=seed)
-    name = _KNOWN.get(tuple(poly))
-    if name is not None:
-        return name
-    det = abs(sum(c * (-1) ** k for k, c in enumerate(poly)))
-    return f"unknown(det={det})"
+    """Knot type of a closed polygon, named from its Alexander polynomial by the table of
+    the knots through 8 crossings (:func:`tightknot.knots.knot_table.knot_name`): "5_2";
+    the candidates joined by "|" where the polynomial does not separate them
+    ("8_20|3_1#3_1"); "unknown(det=..)" outside the table. Chirality-blind, and "0_1"
+    means Delta = 1 (some nontrivial knots have it)."""
+    return knot_name(alexander_polynomial(points, seed=seed))
 
 
 def close_open_curve(

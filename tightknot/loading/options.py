@@ -64,6 +64,7 @@ class Param:
             and resolved later (e.g. "200 closed; 300 open").
         aliases: other spellings of allowed strings, alias -> name.
         metavar: placeholder of its value on the command line.
+        flag_aliases: other flags of the same option (e.g. ``--knot`` for ``--knot-type``).
     """
 
     name: str = ""
@@ -78,6 +79,7 @@ class Param:
     default_text: str = ""
     aliases: Mapping[str, str] = field(default_factory=dict)
     metavar: str | None = None
+    flag_aliases: tuple[str, ...] = ()
 
     @property
     def meaning(self) -> str:
@@ -151,10 +153,11 @@ def format_value(value: Any) -> str:
 
 def param(default: Any = MISSING, valid: Range | tuple[Any, ...] | None = None,
           unit: str = "", what: str = "", *, only: str | None = None, default_text: str = "",
-          aliases: Mapping[str, str] | None = None, metavar: str | None = None) -> Any:
+          aliases: Mapping[str, str] | None = None, metavar: str | None = None,
+          flag_aliases: tuple[str, ...] = ()) -> Any:
     """A dataclass field that is a run parameter (arguments: :class:`Param`'s attributes)."""
     meta = Param(valid=valid, unit=unit, what=what, only=only, default_text=default_text,
-                 aliases=dict(aliases or {}), metavar=metavar)
+                 aliases=dict(aliases or {}), metavar=metavar, flag_aliases=flag_aliases)
     return field(default=default, metadata={"param": meta})
 
 
@@ -188,6 +191,12 @@ def parameters(cls: type) -> Mapping[str, Param]:
 def flag(name: str) -> str:
     """The command-line flag of parameter ``name`` (``--name-with-dashes``)."""
     return "--" + name.replace("_", "-")
+
+
+def flags(p: Param) -> tuple[str, ...]:
+    """Every command-line flag of parameter ``p``: :func:`flag` of its name first (argparse
+    takes the option's name from it), then its ``flag_aliases``."""
+    return (flag(p.name), *p.flag_aliases)
 
 
 def on_off(text: str) -> bool:

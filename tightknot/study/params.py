@@ -18,7 +18,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from tightknot.knots.scenes import DEFAULT_EDGE_D0, default_nodes
+from tightknot.knots.catalogue import KNOT_NAMES
+from tightknot.knots.scenes import (
+    DEFAULT_EDGE_D0,
+    default_l0_over_d0,
+    default_nodes,
+    default_open_length,
+)
 from tightknot.loading.options import LoadPath, Range, format_value, param, parameters
 from tightknot.viz.rerun_log import ROD_FIELDS
 
@@ -26,21 +32,23 @@ if TYPE_CHECKING:
     from tightknot.knots.scenes import KnotScene
 
 KNOTS = ("closed", "open")
-#: Knot types with a scene (tightknot.knots.scenes), and the scene's name of each.
-KNOT_TYPES = ("3_1", "4_1")
-SCENE_NAMES = {"3_1": "trefoil", "4_1": "figure_eight"}
+#: Knot types with a scene (the built-in knots, tightknot.knots.catalogue), and the scene's
+#: name of each (closed_trefoil, open_5_2, ...).
+KNOT_TYPES = KNOT_NAMES
+SCENE_NAMES = {t: {"3_1": "trefoil", "4_1": "figure_eight"}.get(t, t) for t in KNOT_TYPES}
 #: Contact levels that can tie a knot (tightknot.knots.scenes.CONTACT_LEVELS less "off").
 CONTACT_LEVELS = ("compliant", "smoothed", "rigid")
 
 #: Defaults that depend on the knot, (knot, knot_type) -> {key: value} (the vertex count
-#: follows the rest length: :func:`resolve_nodes`): the study's trefoils
-#: (L0/D0 = 16.37; L0 = 185 mm) and the figure-eight scenes' own lengths; twist off for
-#: open knots (an isotropic rod with twist-free ends relaxes its twist to zero).
+#: follows the rest length: :func:`resolve_nodes`): the scenes' own
+#: (:func:`tightknot.knots.scenes.default_l0_over_d0`, :func:`~tightknot.knots.scenes.
+#: default_open_length`: the study's trefoils, L0/D0 = 16.37 and L0 = 185 mm; the others
+#: from their ideal L/D); twist off for open knots (an isotropic rod with twist-free ends
+#: relaxes its twist to zero).
 KNOT_DEFAULTS: Mapping[tuple[str, str], Mapping[str, Any]] = types.MappingProxyType({
-    ("closed", "3_1"): {"l0_over_d0": 16.37, "twist": True},
-    ("closed", "4_1"): {"l0_over_d0": 22.1, "twist": True},
-    ("open", "3_1"): {"length": 0.185, "twist": False},
-    ("open", "4_1"): {"length": 0.30, "twist": False},
+    **{("closed", t): {"l0_over_d0": default_l0_over_d0(t), "twist": True}
+       for t in KNOT_TYPES},
+    **{("open", t): {"length": default_open_length(t), "twist": False} for t in KNOT_TYPES},
 })
 #: Fewest vertices of a knot's scene (tightknot.knots.scenes refuses fewer).
 MIN_NODES = {"closed": 24, "open": 40}
@@ -51,11 +59,20 @@ COLOR_FIELDS = tuple(ROD_FIELDS)
 COLOR_ALIASES = {"contact_width": "contact_width_fraction"}
 
 
-def _knot_default_text(key: str) -> str:
-    """``--help``'s default of a per-knot parameter, from :data:`KNOT_DEFAULTS`
-    (e.g. "200 closed, 300 open"; "16.37 for 3_1, 22.1 for 4_1")."""
+def _knot_default_text(key: str, shown: int = 2) -> str:
+    """``--help``'s default of a per-knot parameter, from :data:`KNOT_DEFAULTS`, for the
+    first ``shown`` knot types (e.g. "on closed, off open"; "16.37 for 3_1, 22.1 for 4_1,
+    per knot for the others")."""
     per_knot = {knot: {t: KNOT_DEFAULTS[(knot, t)][key] for t in KNOT_TYPES
                        if key in KNOT_DEFAULTS[(knot, t)]} for knot in KNOTS}
+    if any(len(set(v.values())) > 1 for v in per_knot.values()):
+        per_knot = {knot: dict(list(v.items())[:shown]) for knot, v in per_knot.items()}
+        return _join_defaults(per_knot) + ", per knot for the others (tightknot.knots.scenes)"
+    return _join_defaults(per_knot)
+
+
+def _join_defaults(per_knot: dict[str, dict[str, Any]]) -> str:
+    """knot -> {knot type: default} as ``--help`` writes it."""
     per_knot = {knot: v for knot, v in per_knot.items() if v}
     parts = []
     for knot, values in per_knot.items():
@@ -77,7 +94,9 @@ class Scene:
 
     knot: str = param(valid=KNOTS, what="closed or open knot")
     knot_type: str = param("3_1", KNOT_TYPES, "",
-                           "knot type: 3_1 trefoil (the study's) or 4_1 figure-eight")
+                           "knot type, its name in the knot table (3_1 the study's trefoil, "
+                           "4_1 figure-eight, torus and twist knots: tightknot.knots."
+                           "catalogue)", flag_aliases=("--knot",), metavar="KNOT")
     l0_over_d0: float | None = param(None, Range(10.0, 1e4), "",
                                      "rest length over diameter L0/D0", only="closed",
                                      default_text=_knot_default_text("l0_over_d0"),
@@ -164,9 +183,10 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     from tightknot.rods.material import Material
 
     material = Material(values["youngs_modulus"], values["poisson"], values["density"])
-    make = getattr(scenes, f"{values['knot']}_{SCENE_NAMES[values['knot_type']]}")
+    make = scenes.closed_knot if values["knot"] == "closed" else scenes.open_knot
     length = values["l0_over_d0"] if values["knot"] == "closed" else values["length"]
     grips = ({"grip_length": values["grip_length"], "grip_twist": values["grip_twist"]}
              if values["knot"] == "open" else {})
-    return make(length, values["diameter"], values["nodes"], material, twist=values["twist"],
+    return make(values["knot_type"], length, values["diameter"], values["nodes"], material,
+                twist=values["twist"],
                 contact=values["contact"], device=device, **grips)

@@ -65,7 +65,7 @@ _LEVEL_FLAGS = {"target_lambda": "--lambda", "pull_force": "--force"}
 def register(subparsers: Any) -> None:
     """Add ``tightknot sweep`` to an argparse ``subparsers``; the case parameters' flags
     are generated from their declarations (:mod:`tightknot.study.params`)."""
-    from tightknot.loading.options import flag, flag_kwargs
+    from tightknot.loading.options import flag, flag_kwargs, flags
     from tightknot.study.params import RUN_PARAMS
     from tightknot.sweep.cases import LEVELS
     from tightknot.sweep.executors import EXECUTORS
@@ -83,7 +83,7 @@ def register(subparsers: Any) -> None:
                    help="the store folder (created; its parent must exist)")
     axes, single = _options()
     for name in axes:
-        p.add_argument(flag(name), **flag_kwargs(RUN_PARAMS[name], nargs="+"))
+        p.add_argument(*flags(RUN_PARAMS[name]), **flag_kwargs(RUN_PARAMS[name], nargs="+"))
     levels = p.add_mutually_exclusive_group()
     what = {"target_lambda": ("open: target knot lengths Lambda_OC", ", one path visiting "
                               "them from the loosest"),
