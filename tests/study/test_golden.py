@@ -7,7 +7,12 @@ edge, 0.15 D0, between solver versions here). Profiles are therefore compared as
 of s centred on the knot (interpolated onto the golden grid), not vertex by vertex:
 re-sampling a spike of the open 185 mm knot one edge off moved kappa D0 by 0.026 at most
 (RMS 0.013), so 0.04 (max) and 0.02 (RMS) separate that from a physics change (a change of
-law or discretisation moved kappa D0 by 0.05 to 0.3). Closed knots have no such slide. Headline
+law or discretisation moved kappa D0 by 0.05 to 0.3). The open scenes are also symmetric under
+the half turn that swaps the rod's two ends, and a knot that settles half an edge off the middle
+has two equilibria, mirror images under that turn: which one a run reaches is round-off too (a
+change of numpy/scipy build landed the 185 mm knot on the golden's mirror image, equal to it
+reversed end for end to 1e-12). An open profile is therefore compared with the golden and with
+the golden read from the other end, and the nearer one counts. Closed knots have no such slide. Headline
 numbers: 1e-3 in stretch and 0.05 in Lambda_OC and L/D (solver tolerance moves them by
 1e-4).
 """
@@ -32,7 +37,10 @@ def test_profile_matches_golden(name: str) -> None:
     assert len(k1) == len(k0)
     if "lambda_oc" in gold:
         inside = np.abs(s0) <= gold["lambda_oc"]  # the knot and a knot length of tail
-        diff = np.interp(s0[inside], s1, k1) - k0[inside]
+        # The golden as measured, and read from the other end (its mirror image, see above).
+        diff = min((np.interp(s0[inside], s1, k1) - k0[inside],
+                    np.interp(s0[inside], -s1[::-1], k1[::-1]) - k0[inside]),
+                   key=lambda d: float(np.max(np.abs(d))))
         assert np.max(np.abs(diff)) <= 0.04
         assert np.sqrt(np.mean(diff**2)) <= 0.02
         assert now["lambda_oc"] == pytest.approx(gold["lambda_oc"], abs=0.05)
