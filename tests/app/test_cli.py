@@ -10,7 +10,8 @@ import pytest
 
 from tightknot.app.cli import build_parser, main
 
-SUBCOMMANDS = ["verify", "bench", "tie", "demo", "view", "analyze", "fem", "calibrate", "sweep"]
+SUBCOMMANDS = ["verify", "bench", "tie", "demo", "view", "analyze", "fem", "calibrate", "sweep",
+               "table", "plot"]
 
 
 @pytest.mark.parametrize("sub", SUBCOMMANDS)

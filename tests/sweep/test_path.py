@@ -44,6 +44,11 @@ def test_levels_along_one_path_and_an_unreachable_level_reported() -> None:
     assert levels[2]["lambda_oc"] < levels[1]["lambda_oc"] - 0.5
     # Each level's profiles are stored (curvature and centerline of every vertex).
     assert len(levels[2]["summary"]["centerline_m"]) == 90
+    # A level says what its 90 vertices cost, as a tie does (issue 20): below the 400 the
+    # trade-off study recommends for an open knot, so a warning.
+    res_note = levels[2]["summary"]["resolution"]
+    assert res_note["nodes"] == 90 and res_note["recommended_nodes"] == 400
+    assert res_note["warning"] and "90 vertices" in res_note["warning"]
     assert [row["target"] for row in res["table"]] == [0.3, 3.0, 4.0]
 
 

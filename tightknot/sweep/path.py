@@ -114,13 +114,17 @@ def measure(scene: KnotScene, result: TieResult) -> dict:
     :func:`tightknot.study.run.run_knot`, same keys)."""
     from tightknot.contact.report import contact_report
     from tightknot.knots.measure import analyze_centerline
+    from tightknot.study.resolution import resolution_note
     from tightknot.study.run import CONTACT_TOL, summarise
 
     x = result.system.state.x
     _, r_v = vertex_radii(scene, x, result.system.rest)
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
                              radii=r_v, contact_tol=CONTACT_TOL)
-    return summarise(scene, result, rep, contact_report(scene.contact, x))
+    out = summarise(scene, result, rep, contact_report(scene.contact, x))
+    # A level's mesh costs what a tie's does (the trade-off study's numbers, as run_knot says).
+    out["resolution"] = resolution_note(scene.closed, scene.model.vertex_count)
+    return out
 
 
 def path_options(scene: KnotScene, residual_tol: float = 1e-6, proximal_steps: int = 60,
