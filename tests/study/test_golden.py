@@ -12,9 +12,9 @@ the half turn that swaps the rod's two ends, and a knot that settles half an edg
 has two equilibria, mirror images under that turn: which one a run reaches is round-off too (a
 change of numpy/scipy build landed the 185 mm knot on the golden's mirror image, equal to it
 reversed end for end to 1e-12). An open profile is therefore compared with the golden and with
-the golden read from the other end, and the nearer one counts. Closed knots have no such slide. Headline
-numbers: 1e-3 in stretch and 0.05 in Lambda_OC and L/D (solver tolerance moves them by
-1e-4).
+the golden read from the other end, and the nearer one counts. Closed knots have no such
+slide. Headline numbers: 1e-3 in stretch and 0.05 in Lambda_OC and L/D (solver tolerance moves
+them by 1e-4).
 """
 
 import json
