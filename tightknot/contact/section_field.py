@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import cho_solve_banded, cholesky_banded
+from scipy.linalg import cho_factor, cho_solve, cho_solve_banded, cholesky_banded
 
 from tightknot.contact.section_modes import mode_stiffness
 
@@ -87,13 +87,16 @@ class FieldState:
 class StraightSectionedRod:
     """Half a straight rod of length ``half_length`` D0 in ``edges`` edges, section modes
     n = 2, 4, ..., ``max_mode``, pressed by ``body``: ``"cylinder"`` (the indent scene: a
-    rigid cylinder of diameter D0 across the rod, axis along e_x at y = D0 - w) or
-    ``"plates"`` (the squeeze: planes y = +-(D0/2 - w) along the whole rod)."""
+    rigid cylinder of diameter D0 across the rod, axis along e_x at y = D0 - w), ``"plates"``
+    (the squeeze: planes y = +-(D0/2 - w) along the whole rod) or ``"rod"`` (a soft rod like
+    this one crossing it at 90 degrees, axes D0 - 2 w apart: the FEM's ``soft_crossing``
+    stack, every rod pressed by one above and one below, so each stays straight and all
+    carry the same field; :meth:`_soft_contact`)."""
 
     def __init__(self, body: str = "cylinder", max_mode: int = 8, half_length: float = 1.5,
                  edges: int = 75, samples: int = 512, gradient: bool = True) -> None:
-        if body not in ("cylinder", "plates"):
-            raise ValueError(f"body must be 'cylinder' or 'plates', got {body!r}")
+        if body not in ("cylinder", "plates", "rod"):
+            raise ValueError(f"body must be 'cylinder', 'plates' or 'rod', got {body!r}")
         if int(max_mode) != max_mode or max_mode < 2:
             raise ValueError(f"max_mode must be an integer >= 2, got {max_mode}")
         if not half_length > 0.0 or edges < 2 or samples < 64:
@@ -199,20 +202,20 @@ class StraightSectionedRod:
         hl[:, 0, 0] = self.h * self.a0
         ql[:, 2:] = self.h * self.k * a
         hl[:, 2:, 2:] += self.h * np.diag(self.k)
-        ct = self._contact(lam, zc, a, w)
-        phi, dphi, d2phi = self._penalty(ct["pen"])
         c = 2.0 * self.weight  # both bodies
-        e += c * float(np.sum(phi))
-        dpen, dy = ct["dpen"], ct["dy"]
-        ql += c * np.einsum("esq,es->eq", dpen, dphi)
-        hl += c * np.einsum("esq,es,esp->eqp", dpen, d2phi, dpen)
-        # phi' times the penetration's own second derivative
-        hl += c * np.einsum("esq,es,esp->eqp", dy, dphi * ct["fyy"], dy)
-        cross = c * np.einsum("esq,es->eq", dy, dphi * ct["fyz"])
-        hl[:, :, 1] += cross
-        hl[:, 1, :] += cross
-        hl[:, 1, 1] += c * np.sum(dphi * ct["fzz"], axis=1)
-        hl += c * np.sum(dphi * ct["fy"] * self.cos_t[None, :], axis=1)[:, None, None] * ct["d2r"]
+        soft = None
+        if self.body == "rod":
+            soft = self._soft_contact(lam, zc, a, w)
+            e += soft[0]
+            ct = None
+        else:
+            ct = self._contact(lam, zc, a, w)
+            phi, dphi, d2phi = self._penalty(ct["pen"])
+            e += c * float(np.sum(phi))
+        if ct is None:
+            pass
+        else:
+            self._rigid_local(ct, dphi, d2phi, c, ql, hl)
         tr = self.transform
         gl = ql @ tr  # per edge, in (Z_i, Z_i+1, a_i)
         hu = np.einsum("qa,eqp,pb->eab", tr, hl, tr)
@@ -240,6 +243,155 @@ class StraightSectionedRod:
         np.add.at(hess, (q_i, q_i), s.ravel())
         np.add.at(hess, (p_i, q_i), -s.ravel())
         np.add.at(hess, (q_i, p_i), -s.ravel())
+        if soft is not None:
+            grad += soft[1]
+            hess += soft[2]
+        return e, grad, hess
+
+    def _rigid_local(self, ct: dict, dphi: NDArray, d2phi: NDArray, c: float, ql: NDArray,
+                     hl: NDArray) -> None:
+        """Add a rigid body's penalty gradient and exact Hessian into each edge's local
+        arrays ``ql``, ``hl`` (variables q = (lambda, z, a))."""
+        dpen, dy = ct["dpen"], ct["dy"]
+        ql += c * np.einsum("esq,es->eq", dpen, dphi)
+        hl += c * np.einsum("esq,es,esp->eqp", dpen, d2phi, dpen)
+        # phi' times the penetration's own second derivative
+        hl += c * np.einsum("esq,es,esp->eqp", dy, dphi * ct["fyy"], dy)
+        cross = c * np.einsum("esq,es->eq", dy, dphi * ct["fyz"])
+        hl[:, :, 1] += cross
+        hl[:, 1, :] += cross
+        hl[:, 1, 1] += c * np.sum(dphi * ct["fzz"], axis=1)
+        hl += c * np.sum(dphi * ct["fy"] * self.cos_t[None, :], axis=1)[:, None, None] * ct["d2r"]
+
+    def _soft_geometry(self, lam: NDArray, zc: NDArray, a: NDArray, w: float) -> dict:
+        """Every sample P of this rod (edges x samples) against the crossing rod's surface:
+        penetration r_B - rho and its first derivatives.
+
+        The crossing rod B is this rod turned by 180 degrees about the line x = z,
+        y = c / 2 (c = D0 - 2 w the axes' distance), so a point P has B's axial coordinate
+        xi = P_x, distance rho = sqrt((c - P_y)^2 + P_z^2) from B's axis and angle
+        theta_B = atan2(P_z, c - P_y) from B's side facing this rod; B's surface radius
+        there is this rod's field (stretch and modes, interpolated linearly between the
+        edges' rest positions) at |xi|. Looking the field up at rest positions leaves out
+        B's axial displacement at the patch (the stretch changes the patch length by
+        lambda - 1, a few per cent); the model is exact for what it states.
+        Derivatives are taken in the per-sample variables v = (lambda_i, z_i, a_i,
+        lambda_k, a_k, lambda_k+1, a_k+1) with k the partner's interval."""
+        nk = len(self.modes)
+        m, ns = self.m, len(self.theta)
+        c = 2.0 * self.r0 - 2.0 * w
+        s_a = self.r0**2 / lam - 0.5 * np.sum(a * a, axis=1)
+        big_r = np.sqrt(s_a)
+        r = big_r[:, None] + a @ self.basis.T
+        sin_t = np.sin(self.theta)
+        px, py = r * sin_t[None, :], r * self.cos_t[None, :]
+        pz = np.broadcast_to(zc[:, None], r.shape)
+        uu, vv = c - py, pz
+        rho = np.sqrt(uu * uu + vv * vv)
+        tb = np.arctan2(vv, uu)
+        # the partner's field at s = |xi| (rest positions h (k + 1/2)); below the first
+        # edge's middle the mirror makes it that edge's
+        s = np.abs(px)
+        pos = s / self.h - 0.5
+        k = np.clip(np.floor(pos).astype(int), 0, m - 2)
+        tt = np.clip(pos - k, 0.0, 1.0)
+        flat = (pos < 0.0) | (pos > m - 1)
+        tt = np.where(pos < 0.0, 0.0, tt)
+        lam_b = (1.0 - tt) * lam[k] + tt * lam[k + 1]
+        a_b = (1.0 - tt)[..., None] * a[k] + tt[..., None] * a[k + 1]
+        s_b = self.r0**2 / lam_b - 0.5 * np.sum(a_b * a_b, axis=-1)
+        big_rb = np.sqrt(s_b)
+        cos_nb = np.cos(np.asarray(self.modes)[None, None, :] * tb[..., None])
+        sin_nb = np.sin(np.asarray(self.modes)[None, None, :] * tb[..., None])
+        r_b = big_rb + np.sum(a_b * cos_nb, axis=-1)
+        pen = r_b - rho
+        # first derivatives, v = (lam_i, z_i, a_i[nk], lam_k, a_k[nk], lam_k1, a_k1[nk])
+        nv = 2 + nk + 2 * (1 + nk)
+        dv = np.zeros((m, ns, nv))
+        # this rod's boundary point
+        dr = np.zeros((m, ns, 2 + nk))
+        dr[:, :, 0] = (-self.r0**2 / lam**2 / (2.0 * big_r))[:, None]
+        dr[:, :, 2:] = self.basis[None, :, :] - (a / (2.0 * big_r[:, None]))[:, None, :]
+        dpx = dr * sin_t[None, :, None]
+        dpy = dr * self.cos_t[None, :, None]
+        dpz = np.zeros_like(dr)
+        dpz[:, :, 1] = 1.0
+        du, dvv = -dpy, dpz
+        drho = (uu[..., None] * du + vv[..., None] * dvv) / rho[..., None]
+        dtb = (uu[..., None] * dvv - vv[..., None] * du) / (rho**2)[..., None]
+        dt = np.where(flat, 0.0, np.sign(px) / self.h)[..., None] * dpx
+        dlam_b_own = (lam[k + 1] - lam[k])[..., None] * dt
+        da_b_own = (a[k + 1] - a[k])[..., :, None] * dt[..., None, :]  # (m, ns, nk, 2+nk)
+        ddr_b = (-self.r0**2 / lam_b**2)[..., None] * dlam_b_own - np.einsum(
+            "esn,esnq->esq", a_b, da_b_own)
+        dr_b_own = ddr_b / (2.0 * big_rb)[..., None]
+        dr_b_own += np.einsum("esn,esnq->esq", cos_nb, da_b_own)
+        dr_b_dtb = -np.sum(a_b * np.asarray(self.modes) * sin_nb, axis=-1)
+        dr_b_own += dr_b_dtb[..., None] * dtb
+        dv[:, :, :2 + nk] = dr_b_own - drho
+        # the partner's sections k and k + 1
+        w0, w1 = (1.0 - tt), tt
+        o = 2 + nk
+        dsb_dlam = -self.r0**2 / lam_b**2 / (2.0 * big_rb)
+        dv[:, :, o] = w0 * dsb_dlam
+        dv[:, :, o + 1 + nk] = w1 * dsb_dlam
+        coef = cos_nb - a_b / (2.0 * big_rb)[..., None]
+        dv[:, :, o + 1:o + 1 + nk] = w0[..., None] * coef
+        dv[:, :, o + 2 + nk:] = w1[..., None] * coef
+        dpen_dc = (dr_b_dtb * (-vv / rho**2)) - uu / rho
+        return {"pen": pen, "dv": dv, "k": k, "dpen_dc": dpen_dc, "r": r, "py": py}
+
+    def _soft_contact(self, lam: NDArray, zc: NDArray, a: NDArray, w: float
+                      ) -> tuple[float, NDArray, NDArray]:
+        """Penalty of this rod's samples against the crossing soft rod (per rod of the stack:
+        both crossings, as for the rigid bodies), its gradient and a Gauss-Newton Hessian
+        (phi'' grad pen grad pen^T: the penalty's phi' times the penetration's own second
+        derivative is left out, 1e-3 of it at the penetrations here; the gradient is exact,
+        so the equilibrium is too, only Newton's rate is not quadratic)."""
+        geo = self._soft_geometry(lam, zc, a, w)
+        pen = geo["pen"]
+        phi, dphi, d2phi = self._penalty(pen)
+        c = 2.0 * self.weight
+        e = c * float(np.sum(phi))
+        grad = np.zeros(self.ndof)
+        hess = np.zeros((self.ndof, self.ndof))
+        on = np.nonzero(pen > 0.0)
+        if on[0].size == 0:
+            return e, grad, hess
+        dv = geo["dv"][on]  # (n, nv)
+        i, k = on[0], geo["k"][on]
+        gv = c * dphi[on][:, None] * dv
+        hv = c * d2phi[on][:, None, None] * dv[:, :, None] * dv[:, None, :]
+        # v -> dofs: lam_e = (Z_e+1 - Z_e) / h, z_e = (Z_e + Z_e+1) / 2, a_e
+        nk = len(self.modes)
+        nv = dv.shape[1]
+        jac = np.zeros((len(i), nv, 5 + 3 * nk))
+        cols = np.full((len(i), 5 + 3 * nk), -1)
+        # own edge: Z_i, Z_i+1, a_i
+        jac[:, 0, 0], jac[:, 0, 1] = -1.0 / self.h, 1.0 / self.h
+        jac[:, 1, 0], jac[:, 1, 1] = 0.5, 0.5
+        jac[:, 2:2 + nk, 2:2 + nk] = np.eye(nk)
+        cols[:, :2] = self.edge_dofs[i, :2]
+        cols[:, 2:2 + nk] = self.edge_dofs[i, 2:]
+        o, oc = 2 + nk, 2 + nk
+        # partner edge k: Z_k, Z_k+1, a_k; edge k + 1: Z_k+2 (Z_k+1 shared), a_k+1
+        jac[:, o, oc], jac[:, o, oc + 1] = -1.0 / self.h, 1.0 / self.h
+        jac[:, o + 1:o + 1 + nk, oc + 2:oc + 2 + nk] = np.eye(nk)
+        jac[:, o + 1 + nk, oc + 1], jac[:, o + 1 + nk, oc + 2 + nk] = -1.0 / self.h, 1.0 / self.h
+        jac[:, o + 2 + nk:, oc + 3 + nk:] = np.eye(nk)
+        cols[:, oc:oc + 2] = self.edge_dofs[k, :2]
+        cols[:, oc + 2:oc + 2 + nk] = self.edge_dofs[k, 2:]
+        cols[:, oc + 2 + nk] = self.edge_dofs[k + 1, 1]
+        cols[:, oc + 3 + nk:] = self.edge_dofs[k + 1, 2:]
+        gd = np.einsum("nv,nvd->nd", gv, jac)
+        hd = np.einsum("nva,nvw,nwb->nab", jac, hv, jac)
+        keep = cols >= 0
+        n = self.ndof
+        grad = np.bincount(cols[keep], weights=gd[keep], minlength=n)
+        pair = keep[:, :, None] & keep[:, None, :]
+        rr = np.broadcast_to(cols[:, :, None], hd.shape)[pair]
+        cc = np.broadcast_to(cols[:, None, :], hd.shape)[pair]
+        hess = np.bincount(rr * n + cc, weights=hd[pair], minlength=n * n).reshape(n, n)
         return e, grad, hess
 
     def solve(self, w: float, start: NDArray | None = None) -> tuple[FieldState, NDArray]:
@@ -269,6 +421,14 @@ class StraightSectionedRod:
     def _newton_step(self, hess: NDArray, g: NDArray) -> NDArray:
         """-H^-1 g by banded Cholesky, H shifted to positive definite where the shrinking mean
         radius makes it indefinite."""
+        if self.body == "rod":  # the crossing couples sections along the patch: dense
+            shift = 0.0
+            while True:
+                try:
+                    chol = cho_factor(hess + shift * np.eye(self.ndof))
+                    return -cho_solve(chol, g)
+                except np.linalg.LinAlgError:
+                    shift = max(2.0 * shift, 1e-8 * float(np.max(np.diag(hess))))
         b = self.bandwidth
         n = self.ndof
         band = np.zeros((b + 1, n))  # upper form: band[b + i - j, j] = H[i, j]
@@ -288,11 +448,20 @@ class StraightSectionedRod:
         z_v, a = self.split(u)
         lam = np.diff(z_v) / self.h
         zc = 0.5 * (z_v[1:] + z_v[:-1])
-        ct = self._contact(lam, zc, a, w)
-        pen = ct["pen"]
-        p = self._penalty(pen)[1]
-        # the body's reaction along y: the half rod's, twice for the other half
-        force = 2.0 * float(np.sum(p * ct["dpen_dc"])) * self.weight
+        if self.body == "rod":
+            ct = self._soft_geometry(lam, zc, a, w)
+            pen = ct["pen"]
+            p = self._penalty(pen)[1]
+            # per crossing of the stack: minus the derivative of a rod's energy (both its
+            # crossings, each shared by two rods) in the axes' distance c, twice for z < 0
+            force = 4.0 * float(np.sum(p * -ct["dpen_dc"])) * self.weight
+            ct["y"] = ct["py"]
+        else:
+            ct = self._contact(lam, zc, a, w)
+            pen = ct["pen"]
+            p = self._penalty(pen)[1]
+            # the body's reaction along y: the half rod's, twice for the other half
+            force = 2.0 * float(np.sum(p * ct["dpen_dc"])) * self.weight
         touching = np.flatnonzero(np.any(pen > 0.0, axis=1))
         axial = float(zc[touching[-1]] + 0.5 * self.h) if touching.size else 0.0
         x = ct["r"][0] * np.sin(self.theta)
