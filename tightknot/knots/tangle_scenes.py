@@ -153,11 +153,15 @@ def tangle_scene(
             curves.check_no_overlap(p, d, closed=False)
         except ValueError as err:
             raise ValueError(f"rod {ROD_NAMES[r]}: {err}") from None
+        # Edges at most pi D0/4, half the contact's exclusion window, as for the one-rod
+        # scenes (tightknot.knots.scenes._check_edge_length: longer neighbouring edges
+        # would pair up as a contact and their shared vertex read as an intersection).
         edge = float(np.linalg.norm(p[1] - p[0]))
-        if edge > 0.5 * d:
+        limit = 0.25 * math.pi * d
+        if edge > limit:
             raise ValueError(f"rod {ROD_NAMES[r]}: nodes={nodes} gives edges of {edge / d:.3g} "
-                             f"D0; the contact needs <= 0.5 D0: give nodes >= "
-                             f"{math.ceil(nodes * edge / (0.5 * d))}")
+                             f"D0, above pi/4 D0: give nodes >= "
+                             f"{math.ceil((nodes - 1) * edge / limit) + 1}")
     gap, i, vi, j, vj = tangles.rod_overlaps(pts, radii)
     if gap < 0.0:
         raise ValueError(f"rods {ROD_NAMES[i]} and {ROD_NAMES[j]} overlap at the start: vertex "
