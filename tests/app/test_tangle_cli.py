@@ -91,3 +91,44 @@ def test_a_tangle_that_comes_apart_exits_1_with_its_state(tmp_path, capsys, monk
     assert "the tangle came apart" in err and "rods A and B" in err
     assert (out / "failed_centerline_A.csv").is_file()
     assert (out / "summary.json").is_file()
+
+
+def _write_reef_files(tmp_path):
+    """The built-in reef's start curves as a user's files: in mm, moved and turned, rod B
+    written from its other end."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from tightknot.knots import tangles
+
+    a, b = tangles.tangle_curves("reef", samples=120)
+    rot = Rotation.from_euler("xyz", [0.4, -1.1, 2.0]).as_matrix()
+    shift = np.array([12.0, -3.0, 40.0])
+    paths = []
+    for name, c in (("a.csv", a), ("b.csv", b[::-1])):
+        pts = (c * 8.5) @ rot.T + shift  # mm
+        path = tmp_path / name
+        path.write_text("x,y,z\n" + "\n".join(f"{p[0]:.9g},{p[1]:.9g},{p[2]:.9g}" for p in pts))
+        paths.append(str(path))
+    return paths
+
+
+def test_user_start_curves(tmp_path):
+    fa, fb = _write_reef_files(tmp_path)
+    out = tmp_path / "own"
+    assert main(["tie", "bend", "--kind", "reef", "--nodes", "60", "--force", "0.5", "--quiet",
+                 "--start-a", fa, "--start-b", fb, "--units", "mm", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["converged"] and s["tangle_type"]["kept"]
+    assert s["tangle_type"]["linking_number"] == 0
+
+
+def test_user_start_curves_of_another_kind_name_the_files(tmp_path, capsys):
+    fa, fb = _write_reef_files(tmp_path)
+    code = main(["tie", "bend", "--kind", "granny", "--nodes", "60", "--quiet",
+                 "--start-a", fa, "--start-b", fb, "--units", "mm",
+                 "--out", str(tmp_path / "x")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert fa in err[0] and "the start curves are not a granny" in err[0]
+    assert main(["tie", "clasp", "--start-a", fa, "--out", str(tmp_path / "y")]) == 2

@@ -25,6 +25,7 @@ _EXAMPLES = """examples:
   tightknot tie clasp --youngs-modulus-b 2.5e6         # rod B twice as stiff
   tightknot tie bend --kind reef --force 1 --out runs/reef
   tightknot tie bend --kind granny --nodes 150
+  tightknot tie bend --kind reef --start-a a.csv --start-b b.csv --units mm   # own curves
 
 outputs (in --out DIR, default runs/<scene>-<UTC time>):
   summary.json         converged, failure, tangle type (linking number, each rod's knot type,
@@ -95,6 +96,13 @@ def build_parser(scene: str) -> argparse.ArgumentParser:
         p.add_argument(f"--{f.name.replace('_', '-')}", type=float, default=None, metavar="D0",
                        help=f"start curve: {f.name.replace('_', ' ')} in rod diameters "
                        f"(default {getattr(geo, f.name):g}; docs/tangles.md)")
+    p.add_argument("--start-a", metavar="FILE", default=None,
+                   help="rod A's start centerline (csv, tsv or x y z per line, as analyze "
+                   "reads; open, U-shaped, both ends pulled one way), with --start-b")
+    p.add_argument("--start-b", metavar="FILE", default=None, help="rod B's start centerline")
+    p.add_argument("--units", default=None, metavar="UNIT",
+                   help="unit of the --start files: m, cm, mm, um or metres per file unit "
+                   "(default: the header's, else m)")
     p.add_argument("--device", default=None, help="Warp device (default cpu)")
     p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>)")
     p.add_argument("--json", metavar="FILE", help="write the summary here instead")
@@ -127,11 +135,30 @@ def _scene(args: argparse.Namespace, kind: str):
         v = getattr(geo, f.name)
         if not (v > 0 and v < 1e3):
             raise ValueError(f"--{f.name.replace('_', '-')} must be in (0, 1000) D0, got {v!r}")
-    return tangle_scene(kind, nodes=args.nodes,
-                        diameter=args.diameter if args.diameter is not None else STUDY_DIAMETER,
-                        material=mat_a, diameter_b=args.diameter_b, material_b=mat_b,
-                        geometry=geo, contact=args.contact,
-                        device=resolve_device(args.device))
+    starts = None
+    if (args.start_a is None) != (args.start_b is None):
+        raise ValueError("--start-a and --start-b go together (one start curve per rod)")
+    if args.start_a is not None:
+        from tightknot.app.analyze import file_units, read_points
+
+        starts = []
+        for path in (args.start_a, args.start_b):
+            factor, _ = file_units(path, args.units, None)
+            pts, _ = read_points(path, factor, False)
+            starts.append(pts)
+    elif args.units is not None:
+        raise ValueError("--units applies to --start-a/--start-b files only")
+    try:
+        return tangle_scene(kind, nodes=args.nodes, curves_m=starts,
+                            diameter=(args.diameter if args.diameter is not None
+                                      else STUDY_DIAMETER),
+                            material=mat_a, diameter_b=args.diameter_b, material_b=mat_b,
+                            geometry=geo, contact=args.contact,
+                            device=resolve_device(args.device))
+    except ValueError as err:
+        if starts is None:
+            raise
+        raise ValueError(f"--start-a {args.start_a}, --start-b {args.start_b}: {err}") from None
 
 
 def run(scene_kind: str, argv: Sequence[str]) -> int:

@@ -51,8 +51,9 @@ def run(kinds: tuple[str, ...] = ("clasp",), nodes: int = 100, force: float = 1.
         rows.append(best)
     clasp = next((r for r in rows if r["kind"] == "clasp"), None)
     return {"warm_up_total_s": warm["total_s"], "rows": rows, "target_s": TARGET_S,
-            "target_met": None if clasp is None else bool(
-                clasp["converged"] and clasp["total_s"] <= TARGET_S and nodes == 100)}
+            # Judged on the target's own scene only (the clasp, 2 x 100 vertices).
+            "target_met": None if clasp is None or nodes != 100 else bool(
+                clasp["converged"] and clasp["total_s"] <= TARGET_S)}
 
 
 def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers type)

@@ -113,6 +113,7 @@ def tangle_scene(
     law: RadialComplianceLaw | None = None,
     device: str = "cpu",
     curves_d0: tuple[np.ndarray, np.ndarray] | None = None,
+    curves_m: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> TangleScene:
     """A two-rod tangle of ``kind`` (module docstring).
 
@@ -128,6 +129,9 @@ def tangle_scene(
         device: Warp device.
         curves_d0: start curves of A and B instead of the built-in ones, in units of the
             larger D0 (their type must still be the kind's).
+        curves_m: the user's start curves of A and B [m] (open, each U-shaped with both
+            ends pulled one way), placed by :func:`tightknot.knots.tangles.pull_frame`;
+            their type must be the kind's.
     """
     if kind != "clasp" and kind not in tangles.BENDS:
         raise ValueError(f"kind must be 'clasp' or one of {', '.join(tangles.BENDS)}, "
@@ -144,7 +148,12 @@ def tangle_scene(
         raise ValueError("contact='off' cannot hold a tangle (the rods pass through each "
                          "other); use 'compliant', 'smoothed' or 'rigid'")
     d_max = max(d_a, d_b)
-    raw = curves_d0 if curves_d0 is not None else tangles.tangle_curves(kind, geometry)
+    if curves_d0 is not None and curves_m is not None:
+        raise ValueError("give curves_d0 or curves_m, not both")
+    if curves_m is not None:
+        raw = [c / d_max for c in tangles.pull_frame(*curves_m)]
+    else:
+        raw = curves_d0 if curves_d0 is not None else tangles.tangle_curves(kind, geometry)
     pts = [curves.resample_equal_chords(np.asarray(c, dtype=np.float64) * d_max, int(nodes))
            for c in raw]
     radii = [0.5 * d_a, 0.5 * d_b]

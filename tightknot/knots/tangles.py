@@ -358,6 +358,39 @@ def rod_overlaps(rods: list[ArrayLike], radii: list[float]) -> tuple[float, int,
     return best
 
 
+def pull_frame(rod_a: ArrayLike, rod_b: ArrayLike) -> tuple[NDArray, NDArray]:
+    """Two rods' centerlines (N, 3) [m] placed in the tangles' frame: the x axis from the
+    midpoint of A's two ends to that of B's (A is pulled toward -x, B toward +x), A's first
+    end on the +y side, the origin between the two midpoints; B reversed if needed so that
+    its first end is on A's first end's side (the parcel closure joins the first ends).
+    A rigid motion: lengths and the tangle's type are unchanged."""
+    a = np.asarray(rod_a, dtype=np.float64)
+    b = np.asarray(rod_b, dtype=np.float64)
+    mid_a, mid_b = 0.5 * (a[0] + a[-1]), 0.5 * (b[0] + b[-1])
+    ex = mid_b - mid_a
+    size = float(np.ptp(np.vstack([a, b]), axis=0).max())
+    if np.linalg.norm(ex) <= 1e-6 * size:
+        raise ValueError("the midpoints of rod A's and rod B's ends coincide: the rods must "
+                         "be pulled apart, A's two ends on one side and B's on the other")
+    ex = ex / np.linalg.norm(ex)
+    ey = None
+    for v in (a[0] - a[-1], b[0] - b[-1]):
+        w = v - (v @ ex) * ex
+        if np.linalg.norm(w) > 1e-6 * size:
+            ey = w / np.linalg.norm(w)
+            break
+    if ey is None:
+        raise ValueError("each rod's two ends lie on the pull axis: a U-shaped rod's ends "
+                         "must be apart across it")
+    ez = np.cross(ex, ey)
+    frame = np.vstack([ex, ey, ez])
+    origin = 0.5 * (mid_a + mid_b)
+    a2, b2 = (a - origin) @ frame.T, (b - origin) @ frame.T
+    if b2[0, 1] < b2[-1, 1]:
+        b2 = b2[::-1].copy()
+    return a2, b2
+
+
 def resample_rods(rod_a: NDArray, rod_b: NDArray, nodes: int) -> tuple[NDArray, NDArray]:
     """Both rods resampled to ``nodes`` vertices of equal chords each."""
     return (curves.resample_equal_chords(rod_a, nodes),
