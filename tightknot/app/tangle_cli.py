@@ -218,7 +218,8 @@ def _run(args: argparse.Namespace, scene_kind: str) -> int:
         print(f"  {'converged':28s} {summary['converged']}")
         print(f"  {'tangle type':28s} {tt['final']} (kept: {tt['kept']}; candidates "
               f"{', '.join(tt['candidates'])})")
-        print(f"  {'pull_force_N':28s} {summary['pull_force_N']:.6g}")
+        force = summary["pull_force_N"]
+        print(f"  {'pull_force_N':28s} {'none' if force is None else f'{force:.6g}'}")
         print(f"  {'end_to_end_m':28s} {summary['end_to_end_m']:.6g}")
         for e in summary["end_reactions"]:
             f = e["force_N"]
@@ -229,6 +230,11 @@ def _run(args: argparse.Namespace, scene_kind: str) -> int:
             print(f"  {'rod ' + rod['rod']:28s} stretch {rod['stretch']:.4f}, max kappa D0 "
                   f"{rod['max_kappa_D0']:.3g}, contact with the other rod over "
                   f"{c['rest_length_over_D0']:.3g} D0 (max w/D0 {c['max_approach_w_over_D0']:.3g})")
+        deep = summary["deepest_contact_between_rods"]
+        if deep is not None:
+            print(f"  {'deepest contact A-B':28s} w/D0 {deep['w_over_D0']:.3g} at vertices "
+                  f"{deep['vertex_A']} (A), {deep['vertex_B']} (B), crossing angle "
+                  f"{deep['crossing_angle_deg']:.1f} deg")
         print(f"  {'load_steps':28s} {summary['load_steps']}")
         print(f"  {'newton_iterations':28s} {summary['newton_iterations']}")
         print(f"  {'wall_time_s':28s} {summary['wall_time_s']:.3g}")

@@ -1,7 +1,7 @@
 """One two-rod tangle run end to end: pull, measure each rod, summarise, log, draw.
 
 Measurements per rod (physics.md sec. 2, applied to each rod on its own): its stretch L/L0
-and largest edge stretch, its curvature kappa D0 (Bergou's discrete curvature, the tails'
+between the grips and largest edge stretch, its curvature kappa D0 (Bergou's discrete curvature, the tails'
 end vertices excluded), its contact with the other rod (how many of its vertices touch it,
 over how much rest length, the deepest per-side approach w/D0 and the peak pressure p/E
 there) and with itself, and its smallest section area A/A0. The tangle's invariants and
@@ -21,6 +21,7 @@ from tightknot.contact.report import ContactReport, contact_report
 from tightknot.knots import tangles
 from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.tangle_scenes import ROD_NAMES, TangleScene
+from tightknot.knots.topology import TopologyError
 from tightknot.loading.tangle_pull import PullResult, end_reactions, pull_tangle, pulling_force
 from tightknot.solvers.system import RodSystem
 from tightknot.viz.rerun_log import ROD_COLORS_RGB
@@ -89,6 +90,7 @@ def measure_rods(scene: TangleScene, system: RodSystem) -> list[dict]:
     out = []
     for r, info in enumerate(m.rods):
         d0 = info.diameter
+        free = slice(info.edge_start + 1, info.edge_start + info.edge_count - 1)
         vs = np.arange(info.vertex_start, info.vertex_start + info.vertex_count)
         kappa = bergou_curvature(x[info.vertex_slice], False)[1:-1] * d0
         touch_other = np.unique(np.r_[between[:, 0], between[:, 1]].astype(int))
@@ -104,7 +106,9 @@ def measure_rods(scene: TangleScene, system: RodSystem) -> list[dict]:
             "diameter_m": d0,
             "youngs_modulus_Pa": info.material.youngs_modulus,
             "rest_length_m": float(rest[info.edge_slice].sum()),
-            "stretch": float(lengths[info.edge_slice].sum() / rest[info.edge_slice].sum()),
+            # Between the grips: the edge inside each grip is held at its length in a
+            # clamped grip and free in a dead-loaded one, so it is left out of both.
+            "stretch": float(lengths[free].sum() / rest[free].sum()),
             "max_edge_stretch": float(np.max(lengths[info.edge_slice] / rest[info.edge_slice])),
             "max_kappa_D0": float(np.max(kappa)),
             "mean_kappa_D0": float(np.mean(kappa)),
@@ -118,6 +122,36 @@ def measure_rods(scene: TangleScene, system: RodSystem) -> list[dict]:
             "min_area_ratio": float(np.min(rep.area_ratio[vs])),
         })
     return out
+
+
+def _tangent(scene: TangleScene, x: np.ndarray, v: int) -> np.ndarray:
+    """Unit tangent of the centerline at vertex ``v`` (central difference within its rod)."""
+    info = scene.model.rods[int(scene.model.vertex_rod[v])]
+    lo = max(v - 1, info.vertex_start)
+    hi = min(v + 1, info.vertex_start + info.vertex_count - 1)
+    t = x[hi] - x[lo]
+    return t / np.linalg.norm(t)
+
+
+def deepest_contact(scene: TangleScene, system: RodSystem) -> dict | None:
+    """The deepest contact between the two rods: its vertices, per-side approach w/D0 and
+    the angle between the two centerlines there [deg] (90: the orthogonal contact of a
+    tight clasp, Grandgeorge et al. 2021); None when the rods do not touch."""
+    x = system.state.x
+    rep = contact_report(scene.contact, x, system.rest)
+    between, _ = _split_pairs(scene, rep)
+    if not between.shape[0]:
+        return None
+    k = int(np.argmax(between[:, 2]))
+    va, vb = int(between[k, 0]), int(between[k, 1])
+    if scene.model.vertex_rod[va] != 0:
+        va, vb = vb, va
+    cos = abs(float(_tangent(scene, x, va) @ _tangent(scene, x, vb)))
+    d0 = max(scene.diameters)
+    return {"vertex_A": va - scene.model.rods[0].vertex_start,
+            "vertex_B": vb - scene.model.rods[1].vertex_start,
+            "w_over_D0": 0.5 * float(between[k, 2]) / d0,
+            "crossing_angle_deg": float(np.degrees(np.arccos(min(cos, 1.0))))}
 
 
 def _calibration(scene: TangleScene, rods: list[dict]) -> dict:
@@ -142,7 +176,14 @@ def summarise(scene: TangleScene, res: PullResult) -> dict:
     """The JSON summary of a pulled tangle."""
     system = res.system
     rods = measure_rods(scene, system)
-    final_type = scene.tangle_type(system.state.x)
+    try:
+        final = scene.tangle_type(system.state.x)
+        final_type = {"linking_number": final.linking_number,
+                      "component_types": list(final.component_types),
+                      "closure_type": final.closure_type, "final": final.label()}
+    except TopologyError:
+        final_type = {"linking_number": None, "component_types": None, "closure_type": None,
+                      "final": "undefined (two pieces of rod nearly meet)"}
     cal = _calibration(scene, rods)
     return {
         "scene": scene.name,
@@ -150,13 +191,10 @@ def summarise(scene: TangleScene, res: PullResult) -> dict:
         "converged": res.converged,
         "failure": res.failure,
         "tangle_type": {
-            "linking_number": final_type.linking_number,
-            "component_types": list(final_type.component_types),
-            "closure_type": final_type.closure_type,
+            **final_type,
             "working_ends": scene.ends,
             "start": scene.start_type.label(),
-            "final": final_type.label(),
-            "kept": final_type.label() == scene.start_type.label(),
+            "kept": final_type["final"] == scene.start_type.label(),
             "candidates": list(tangles.CANDIDATES[scene.kind]),
         },
         "tangle_types_per_step": res.tangle_types,
@@ -165,10 +203,11 @@ def summarise(scene: TangleScene, res: PullResult) -> dict:
             "pulling_force_N": [p[1] for p in res.force_extension],
             "phase": [p[2] for p in res.force_extension],
         },
-        "pull_force_N": res.pull_force_N,
+        "pull_force_N": res.pull_force_N if math.isfinite(res.pull_force_N) else None,
         "end_to_end_m": scene.end_distance(system.state.x),
         "end_reactions": [r.to_dict() for r in res.reactions],
         "rods": rods,
+        "deepest_contact_between_rods": deepest_contact(scene, system),
         "calibration": cal,
         "warnings": cal["warnings"],
         "load_steps": len(res.force_extension),
