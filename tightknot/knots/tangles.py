@@ -19,7 +19,7 @@ two-strand pretzel, i.e. the torus link T(2, n_upper + n_lower): its linking num
 * reef (square): three half turns of opposite hands, P(3, -3) = the unlink (lk = 0);
   the parcel closure gives the square knot 3_1 # 3_1*.
 * thief and grief: the reef's and the granny's tangle with the working ends on opposite
-  sides (Ashley Book of Knots #1206, #1207; Patil et al., Science 367 (2020) 71). The
+  sides (as Patil et al., Science 367 (2020) 71, tie them). The
   four-end pull loads all four ends, so the working ends are only labels there: a thief
   and a reef (a grief and a granny) are the same tangle, and no invariant of the tangle
   separates them. Only the labels do: the parcel closure joins A's working end to B's
@@ -33,8 +33,8 @@ two-strand pretzel, i.e. the torus link T(2, n_upper + n_lower): its linking num
 So the invariants of the tangle (the linking number of the per-rod closure, each rod's own
 knot type) separate {reef, thief} from {granny, grief} from the clasp; the parcel closure
 of the labelled tangle also separates the thief from the reef and the grief from the
-granny, but no invariant here separates the reef from the granny's closure type, only
-their linking numbers do (:data:`CANDIDATES`: the kinds the tangle's own invariants leave).
+granny; its Alexander polynomial does not separate the reef from the granny, their linking
+numbers do (:data:`CANDIDATES`: the kinds the tangle's own invariants leave).
 """
 
 from __future__ import annotations
@@ -45,10 +45,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tightknot.knots import curves, topology
+from tightknot.knots import topology
 
 #: Bend kinds and their twist regions (n_upper, n_lower, hand_upper, hand_lower) and the
-#: working ends ("same": both on the upper side; "diagonal": A's upper, B's lower).
+#: working ends ("same": both on the upper side; "diagonal": A's upper, B's lower). A hand
+#: is the sign of z in a side's helices (:func:`_side`); the lower side is the upper one
+#: mirrored in y, so equal hands make helices of opposite handedness: P(3, -3), the reef
+#: (the computed linking number, 0, confirms which is which).
 BENDS: dict[str, tuple[int, int, int, int, str]] = {
     "reef": (3, 3, 1, 1, "same"),
     "thief": (3, 3, 1, 1, "diagonal"),
@@ -389,9 +392,3 @@ def pull_frame(rod_a: ArrayLike, rod_b: ArrayLike) -> tuple[NDArray, NDArray]:
     if b2[0, 1] < b2[-1, 1]:
         b2 = b2[::-1].copy()
     return a2, b2
-
-
-def resample_rods(rod_a: NDArray, rod_b: NDArray, nodes: int) -> tuple[NDArray, NDArray]:
-    """Both rods resampled to ``nodes`` vertices of equal chords each."""
-    return (curves.resample_equal_chords(rod_a, nodes),
-            curves.resample_equal_chords(rod_b, nodes))

@@ -1,11 +1,13 @@
 """One two-rod tangle run end to end: pull, measure each rod, summarise, log, draw.
 
 Measurements per rod (physics.md sec. 2, applied to each rod on its own): its stretch L/L0
-between the grips and largest edge stretch, its curvature kappa D0 (Bergou's discrete curvature, the tails'
-end vertices excluded), its contact with the other rod (how many of its vertices touch it,
-over how much rest length, the deepest per-side approach w/D0 and the peak pressure p/E
-there) and with itself, and its smallest section area A/A0. The tangle's invariants and
-every end's reaction come from the load path (:mod:`tightknot.loading.tangle_pull`).
+between the grips and largest edge stretch, its curvature kappa D0 (Bergou's discrete
+curvature, the end vertices excluded), its contact with the other rod (how many of its
+vertices touch it, over how much rest length, the deepest per-side approach w/D0 and the
+peak pressure p/E there) and with itself, and its smallest section area A/A0; for the
+pair, the deepest contact between the rods and the angle at which they cross there. The
+tangle's invariants and every end's reaction come from the load path
+(:mod:`tightknot.loading.tangle_pull`).
 """
 
 from __future__ import annotations
