@@ -19,7 +19,8 @@ two-strand pretzel, i.e. the torus link T(2, n_upper + n_lower): its linking num
 * reef (square): three half turns of opposite hands, P(3, -3) = the unlink (lk = 0);
   the parcel closure gives the square knot 3_1 # 3_1*.
 * thief and grief: the reef's and the granny's tangle with the working ends on opposite
-  sides (as Patil et al., Science 367 (2020) 71, tie them). The
+  sides (as Patil et al., Science 367 (2020) 71, tie them; an assumption of this
+  construction, not checked against a table of tangles). The
   four-end pull loads all four ends, so the working ends are only labels there: a thief
   and a reef (a grief and a granny) are the same tangle, and no invariant of the tangle
   separates them. Only the labels do: the parcel closure joins A's working end to B's
