@@ -57,6 +57,20 @@ def test_overlapping_rods_are_bad_input(tmp_path, capsys):
     assert len(err) == 1 and "rods A and B overlap at the start" in err[0]
 
 
+@pytest.mark.parametrize("flags, words", [
+    (["--youngs-modulus-b", "0"], "rod B (--youngs-modulus-b, --poisson-b)"),
+    (["--poisson", "0.7"], "rod A (--youngs-modulus, --poisson)"),
+    (["--end-distance", "0.01"], "end_distance must exceed the start's"),
+    (["--nodes", "10"], "nodes must be a whole number >= 40"),
+    (["--side-offset", "0.9"], "rod A: centerline overlaps itself"),
+])
+def test_bad_input_is_one_line_exit_2(tmp_path, capsys, flags, words):
+    code = main(["tie", "clasp", "--nodes", "60", "--quiet", *flags,
+                 "--out", str(tmp_path / "x")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and words in err[0]
+
+
 def test_bend_needs_its_kind(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["tie", "bend", "--nodes", "80"])

@@ -88,6 +88,12 @@ def test_bad_loads_are_refused():
         pull_tangle(scene)
     with pytest.raises(ValueError, match="force must be finite"):
         pull_tangle(scene, force=-1.0)
+    # The grips only pull apart: a target short of the start is known bad before a solve.
+    short = 0.5 * scene.end_distance(scene.state.x)
+    with pytest.raises(ValueError, match="end_distance must exceed the start's"):
+        pull_tangle(scene, end_distance=short)
+    with pytest.raises(ValueError, match="max_end_distance must exceed"):
+        pull_tangle(scene, force=1.0, max_end_distance=short)
 
 
 def test_rods_of_different_stiffness_are_pulled_and_flagged():

@@ -122,12 +122,18 @@ def _scene(args: argparse.Namespace, kind: str):
     from tightknot.warp_setup import resolve_device
 
     base = STUDY_MATERIAL
-    mat_a = Material(
-        args.youngs_modulus if args.youngs_modulus is not None else base.youngs_modulus,
-        args.poisson if args.poisson is not None else base.poisson_ratio, base.density)
-    mat_b = Material(
-        args.youngs_modulus_b if args.youngs_modulus_b is not None else mat_a.youngs_modulus,
-        args.poisson_b if args.poisson_b is not None else mat_a.poisson_ratio, base.density)
+    mats = []
+    for rod, e, nu, like in (("A", args.youngs_modulus, args.poisson, base),
+                             ("B", args.youngs_modulus_b, args.poisson_b, None)):
+        like = like or mats[0]
+        try:
+            mats.append(Material(e if e is not None else like.youngs_modulus,
+                                 nu if nu is not None else like.poisson_ratio, base.density))
+        except ValueError as err:
+            flags = ("--youngs-modulus-b, --poisson-b" if rod == "B"
+                     else "--youngs-modulus, --poisson")
+            raise ValueError(f"rod {rod} ({flags}): {err}") from None
+    mat_a, mat_b = mats
     geo = tangles.TangleGeometry(**{
         f.name: getattr(args, f.name) for f in dataclasses.fields(tangles.TangleGeometry)
         if getattr(args, f.name) is not None})
@@ -179,9 +185,8 @@ def _run(args: argparse.Namespace, scene_kind: str) -> int:
 
     kind = "clasp" if scene_kind == "clasp" else args.kind
     name = kind if kind == "clasp" else f"{kind}_bend"
-    for flag in ("nodes", "pull_steps"):
-        if getattr(args, flag) < 1:
-            raise ValueError(f"--{flag.replace('_', '-')} must be >= 1, got {getattr(args, flag)}")
+    if args.pull_steps < 1:
+        raise ValueError(f"--pull-steps must be >= 1, got {args.pull_steps}")
     outs = plan_outputs(name, args.out, args.json, args.rrd, args.figures,
                         overwrite=args.overwrite)
     scene = _scene(args, kind)

@@ -171,6 +171,15 @@ def pull_tangle(
                     ("max_end_distance", max_end_distance)):
         if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be finite and > 0, got {v!r}")
+    # The grips hold the ends where they start, so the relaxed start's end distance is the
+    # start's: a target short of it is bad input, known before any solve.
+    d_start = scene.end_distance(scene.state.x)
+    if end_distance is not None and end_distance <= d_start:
+        raise ValueError(f"end_distance must exceed the start's end-to-end distance "
+                         f"{d_start:.6g} m (the grips pull the rods apart), got {end_distance!r}")
+    if max_end_distance is not None and max_end_distance <= d_start:
+        raise ValueError(f"max_end_distance must exceed the start's end-to-end distance "
+                         f"{d_start:.6g} m, got {max_end_distance!r}")
     start = time.perf_counter()
     label = tangle_type or _label
     expected = scene.start_type.label()
