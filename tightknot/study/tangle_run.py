@@ -136,7 +136,8 @@ def _tangent(scene: TangleScene, x: np.ndarray, v: int) -> np.ndarray:
 
 
 def deepest_contact(scene: TangleScene, system: RodSystem) -> dict | None:
-    """The deepest contact between the two rods: its vertices, per-side approach w/D0 and
+    """The deepest contact between the two rods: its vertices, per-side approach w/D0 (D0
+    the larger rod diameter) and
     the angle between the two centerlines there [deg] (90: the orthogonal contact of a
     tight clasp, Grandgeorge et al. 2021); None when the rods do not touch."""
     x = system.state.x
