@@ -74,6 +74,8 @@ _TIE_EXAMPLES = """examples:
   tightknot tie open --length 0.185 --force 5 --json open.json
   tightknot tie closed --knot-type 4_1 --out runs/eight  # the figure-eight knot
   tightknot tie closed --knot 5_1                        # any built-in knot (--knot-type)
+  tightknot tie clasp --force 1                          # two rods: tightknot tie clasp --help
+  tightknot tie bend --kind reef                         # reef, granny, thief, grief
   tightknot tie open --knot 5_2 --force 1
   tightknot tie --config runs/tight/config.json --out runs/tight-again   # rerun a run
   tightknot tie --config runs/tight/config.json --nodes 400              # ... with a change
@@ -394,6 +396,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``tightknot`` console script; returns the exit code."""
+    from tightknot.app import tangle_cli
+
+    words = list(sys.argv[1:] if argv is None else argv)
+    if words[:1] == ["tie"] and words[1:2] and words[1] in tangle_cli.TANGLES:
+        return tangle_cli.run(words[1], words[2:])  # two rods: tightknot tie clasp|bend
     parser = build_parser()
     args = parser.parse_args(argv)
     if getattr(args, "handler", None) is None:

@@ -14,7 +14,7 @@ from typing import Any
 
 #: Benchmark modules, in the order ``tightknot bench --help`` lists them.
 BENCHMARKS = ("der", "contact", "knots", "sweep", "batch", "tradeoff", "scaling", "peers",
-              "force_range")
+              "force_range", "tangles")
 
 _EXAMPLES = """examples:
   tightknot bench der --json der.json

@@ -70,6 +70,10 @@ CONTACT_CMAP = "magma"
 # Uniform colour of a rod logged without a field (light steel blue: neutral, not on any map).
 ROD_PLAIN_RGB = (176, 196, 222)
 
+# Uniform colours of the rods of a several-rod scene, rod 0 first (blue, orange, green,
+# red: the figures' colours, so that a rod has one colour in the viewer and in the plots).
+ROD_COLORS_RGB = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40))
+
 # The reference (ideal) knot is drawn as its grey centreline, thinner than the tube so that the
 # elastic rod around it stays visible: this fraction of the reference tube radius.
 REFERENCE_LINE_FRACTION = 0.15
@@ -106,6 +110,7 @@ class VisualLogger(Protocol):
         *,
         field_at: FieldLocation | None = None,
         radii_at: FieldLocation | None = None,
+        color: tuple[int, int, int] | None = None,
     ) -> None: ...
     def log_contacts(
         self,
@@ -353,6 +358,7 @@ class RerunLogger:
         *,
         field_at: FieldLocation | None = None,
         radii_at: FieldLocation | None = None,
+        color: tuple[int, int, int] | None = None,
     ) -> None:
         """Log a rod as a tube: one ``LineStrips3D`` strip per edge, plus ``<name>/vertices``.
 
@@ -379,6 +385,9 @@ class RerunLogger:
         field_at, radii_at:
             Force "vertex" or "edge"; only needed for a closed rod (N == E), where the default
             is the field's natural place (:data:`ROD_FIELDS`) and "edge" for radii.
+        color:
+            Uniform RGB colour (0..255) of a rod logged without a field (default
+            :data:`ROD_PLAIN_RGB`; several rods: :data:`ROD_COLORS_RGB`).
         """
         if field_name is not None:
             _check_field_name(field_name)
@@ -397,8 +406,11 @@ class RerunLogger:
             values = to_edges(field, n, closed, default_at=natural_at, at=field_at, what="field")
             colors = colorize(values, cmap, limits if limits is not None else default_limits)
         else:
+            rgb = ROD_PLAIN_RGB if color is None else tuple(int(c) for c in color)
+            if len(rgb) != 3 or not all(0 <= c <= 255 for c in rgb):
+                raise ValueError(f"color must be three integers in [0, 255], got {color!r}")
             colors = np.broadcast_to(
-                np.array(ROD_PLAIN_RGB + (255,), dtype=np.uint8), (r.shape[0], 4)
+                np.array(rgb + (255,), dtype=np.uint8), (r.shape[0], 4)
             )
         rec = self._temporal()
         rec.log(entity, rr.LineStrips3D(edge_segments(p, closed), radii=r, colors=colors))
@@ -572,6 +584,7 @@ class NullLogger:
         *,
         field_at: FieldLocation | None = None,
         radii_at: FieldLocation | None = None,
+        color: tuple[int, int, int] | None = None,
     ) -> None:
         """Do nothing."""
 
