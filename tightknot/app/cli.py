@@ -75,6 +75,8 @@ _TIE_EXAMPLES = """examples:
   tightknot tie closed --knot-type 4_1 --out runs/eight  # the figure-eight knot
   tightknot tie closed --knot 5_1                        # any built-in knot (--knot-type)
   tightknot tie open --knot 5_2 --force 1
+  tightknot tie --start knot.csv --closed --l0-over-d0 24 --units mm   # your own curve
+  tightknot tie --start overhand.txt --open --force 1    # its type is detected and kept
   tightknot tie --config runs/tight/config.json --out runs/tight-again   # rerun a run
   tightknot tie --config runs/tight/config.json --nodes 400              # ... with a change
 
@@ -97,7 +99,10 @@ def tie_config(args: argparse.Namespace):
     from tightknot.loading.options import LOADS
 
     data: dict = load_config(args.config).to_dict() if args.config is not None else {}
-    knot = args.knot if args.knot is not None else data.get("knot")
+    flag = getattr(args, "knot_flag", None)  # --closed / --open (with --start)
+    if flag is not None and args.knot is not None and flag != args.knot:
+        raise ValueError(f"--{flag} contradicts the knot {args.knot}")
+    knot = args.knot or flag or data.get("knot")
     if knot is None:
         raise ValueError("give the knot (closed or open) or --config FILE")
     if "knot" in data:
@@ -346,6 +351,11 @@ def build_parser() -> argparse.ArgumentParser:
     for name, par in params.items():
         if name != "knot":
             p.add_argument(*flags(par), **flag_kwargs(par))
+    closed_open = p.add_mutually_exclusive_group()
+    for kind in ("closed", "open"):
+        closed_open.add_argument(f"--{kind}", dest="knot_flag", action="store_const",
+                                 const=kind, help=f"the knot is {kind} (as the positional "
+                                 f"{kind}; reads well with --start)")
     p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>; "
                    "made with its parents under runs/, elsewhere its parent must exist)")
     p.add_argument("--json", metavar="FILE", help="write the summary here instead")

@@ -291,6 +291,10 @@ def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
     # What the mesh costs in accuracy, so a coarse run says so (the trade-off study's numbers);
     # its warning stays in this entry: "warnings" are about the contact law's validity.
     summary["resolution"] = resolution_note(scene.closed, scene.model.vertex_count)
+    if "start" in scene.info:
+        # A user's start curve: its file, unit and size; knot_type is the type detected on
+        # it and kept at every load step.
+        summary["start_curve"] = dict(scene.info["start"])
     return KnotRun(scene, res, rep, contact, summary)
 
 
