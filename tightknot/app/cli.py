@@ -125,7 +125,7 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     from tightknot.app.progress import Progress, phase_progress
     from tightknot.app.run_folder import plan_outputs, write_centerline
     from tightknot.atomic import write_json_atomic
-    from tightknot.knots.ideal import load_ideal_trefoil
+    from tightknot.knots.ideal import has_ideal, load_ideal
     from tightknot.study.params import build_scene
     from tightknot.study.run import draw_figures, run_knot
     from tightknot.viz.rerun_log import make_logger
@@ -144,10 +144,11 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     write_json_atomic(outs.config, cfg.to_dict())
     bar = Progress(scene.name, enabled=False if args.quiet else None)
     with make_logger(outs.rrd) as log:
-        if scene.closed and scene.knot_type == "3_1":
-            ideal = load_ideal_trefoil(scene.diameter)
+        if scene.closed and has_ideal(scene.knot_type):
+            ideal = load_ideal(scene.knot_type, scene.diameter)
             # Beside the rod (6 D0 below), so that both stay visible.
-            log.log_reference("ideal_trefoil",
+            log.log_reference("ideal_trefoil" if scene.knot_type == "3_1"
+                              else f"ideal_{scene.knot_type}",
                               ideal - ideal.mean(axis=0) + [0.0, 0.0, -6 * scene.diameter],
                               scene.diameter / 2)
         with bar:

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from tightknot.knots.catalogue import KNOT_NAMES
 from tightknot.knots.scenes import (
     DEFAULT_EDGE_D0,
+    START_SHAPES,
     default_l0_over_d0,
     default_nodes,
     default_open_length,
@@ -145,6 +146,10 @@ class StartFile:
                                 "numbers (2,3,4) or header names",
                                 default_text="as tightknot analyze picks them",
                                 metavar="X,Y,Z")
+    start_shape: str = param("parametric", START_SHAPES, "",
+                             "start of a built-in closed knot: its family's parametric curve, "
+                             "or the shipped ideal polygon (3_1, 4_1, 5_1, 6_1, 8_19; "
+                             "tightknot.knots.ideal)", only="closed")
 
 
 @dataclass(frozen=True)
@@ -187,6 +192,14 @@ def check_scene(values: Mapping[str, Any]) -> None:
         p = RUN_PARAMS["nodes"]
         raise ValueError(f"nodes: {nodes!r} is out of range for {knot} knots; valid: "
                          f"[{MIN_NODES[knot]}, {p.valid.high:g}] ({p.meaning})")
+    shape = values.get("start_shape", StartFile.start_shape)
+    if shape != "parametric":
+        from tightknot.knots.ideal import IDEAL_KNOTS
+
+        kt = values.get("knot_type", Scene.knot_type)
+        if knot != "closed" or values.get("start") is not None or kt not in IDEAL_KNOTS:
+            raise ValueError(f"start_shape {shape}: for a closed built-in knot whose ideal "
+                             f"shape is shipped ({', '.join(IDEAL_KNOTS)}), without start")
     length = values.get("length")
     if knot == "open" and length is not None:
         d0 = values.get("diameter", Scene.diameter)
@@ -252,6 +265,8 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     length = values["l0_over_d0"] if values["knot"] == "closed" else values["length"]
     grips = ({"grip_length": values["grip_length"], "grip_twist": values["grip_twist"]}
              if values["knot"] == "open" else {})
+    shape = ({"start_shape": values.get("start_shape", StartFile.start_shape)}
+             if values["knot"] == "closed" else {})
     return make(values["knot_type"], length, values["diameter"], values["nodes"], material,
                 twist=values["twist"],
-                contact=values["contact"], device=device, **grips)
+                contact=values["contact"], device=device, **grips, **shape)
