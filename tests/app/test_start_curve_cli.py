@@ -148,3 +148,40 @@ def test_intersecting_curve_names_its_vertices() -> None:
     assert np.linalg.norm(pts[i] - pts[j]) == pytest.approx(d, rel=0.05)
     # Slightly closer than the 2 % margin: grown to it, not refused.
     assert check_no_intersection(curve, 1.01 * d / 1.02) == pytest.approx(1.01)
+
+
+def test_ideal_start_shape_ties_and_reports_fitting_measures(tmp_path: Path,
+                                                             monkeypatch) -> None:
+    from tightknot.viz import figures
+
+    titles: list[str] = []
+    real = figures.plot_closed_profiles
+
+    def spy(report, path, ideal=None, label="knot", knot="closed trefoil"):
+        titles.append(knot)
+        assert ideal is not None and ideal["aligned"] is not None  # the ideal 4_1, placed
+        return real(report, path, ideal=ideal, label=label, knot=knot)
+
+    monkeypatch.setattr(figures, "plot_closed_profiles", spy)
+    out = tmp_path / "run"
+    assert main(["tie", "closed", "--knot", "4_1", "--start-shape", "ideal", "--nodes", "100",
+                 "--out", str(out), *FAST]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] and summary["knot_type"] == "4_1"
+    # No trefoil's 3-fold axis: null with the reason, not a misleading number.
+    assert summary["rho"] is None and summary["z"] is None
+    assert not summary["threefold"]["applied"] and "4_1" in summary["threefold"]["reason"]
+    assert summary["ideal"]["L_over_D"] == pytest.approx(21.0483)
+    assert "measured" in summary["ideal"]["source"] and summary["ideal"]["shape_shipped"]
+    assert titles == ["closed figure-eight 4_1"]
+    assert json.loads((out / "config.json").read_text())["start_shape"] == "ideal"
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["tie", "closed", "--knot", "5_2", "--start-shape", "ideal"], "start_shape ideal"),
+    (["tie", "open", "--knot", "5_1", "--force", "1", "--start-shape", "ideal"],
+     "start_shape ideal"),
+])
+def test_ideal_start_shape_bad_input(argv, message, tmp_path: Path, capsys) -> None:
+    err = _error([*argv, "--out", str(tmp_path / "r")], capsys)
+    assert message in err and "3_1, 4_1, 5_1, 6_1, 8_19" in err
