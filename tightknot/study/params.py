@@ -231,6 +231,10 @@ def resolve_start(values: Mapping[str, Any]) -> dict[str, Any]:
     d0 = values.get("diameter", Scene.diameter)
     start_curve.check_no_intersection(curve, d0)
     detected = start_curve.detect_knot_type(curve)
+    if not start_curve.is_knot_name(detected):
+        # "undefined ...": no generic projection, the curve nearly passes through itself.
+        raise start_curve.StartCurveError(f"{curve.source}: its knot type cannot be "
+                                          f"determined: {detected}")
     start_curve.check_knot_type(curve, detected, values.get("knot_type"))
     # The scene keeps the detected name: the topology checks compare it at every step.
     out: dict[str, Any] = {"knot_type": detected}
