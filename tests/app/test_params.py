@@ -26,7 +26,8 @@ from tightknot.study.params import (
 from tightknot.sweep.cases import CASE_KEYS, LEVELS, NOT_CASE_KEYS, canonical, defaults
 
 #: Options of the two commands that are not run parameters.
-TIE_OTHER = {"help", "config", "out", "json", "figures", "rrd", "quiet", "overwrite"}
+TIE_OTHER = {"help", "config", "out", "json", "figures", "rrd", "quiet", "overwrite",
+             "knot_flag"}
 SWEEP_OTHER = {"help", "out", "executor", "workers", "scheduler", "batch", "retry_failed",
                "json", "quiet"}
 

@@ -306,7 +306,9 @@ def summary_lines(report: Mapping[str, Any], path: str, closed_source: str,
 
 
 def write_figures(report: Mapping[str, Any], folder: Path, label: str) -> list[Path]:
-    """Closed knot: profiles and contact map with the ideal trefoil; open knot: one figure."""
+    """Closed knot: profiles and contact map with the ideal knot of its type where one is
+    shipped (a trefoil's as measured; another's placed by its best-matching curvature,
+    tightknot.knots.ideal_overlay); open knot: one figure."""
     from tightknot.viz.figures import plot_closed_profiles, plot_contact_map, plot_open_knots
 
     folder.mkdir(exist_ok=True)
@@ -314,16 +316,18 @@ def write_figures(report: Mapping[str, Any], folder: Path, label: str) -> list[P
         out = folder / OPEN_KNOT_PNG
         plot_open_knots({label: report}, out)
         return [out]
-    from tightknot.knots.ideal import load_ideal_trefoil
-    from tightknot.knots.measure import analyze_centerline
+    from tightknot.knots.ideal_overlay import aligned, ideal_report
 
     # The plotted quantities (s, rho, z, kappa*D0) are non-dimensional, so the ideal knot is
-    # measured at D = 1. A tight contact tolerance keeps only its double-contact lines.
-    ideal = analyze_centerline(load_ideal_trefoil(1.0), 1.0, closed=True,
-                               contact_tol=IDEAL_CONTACT_TOL)
+    # measured at D = 1 (with a tight contact tolerance: only its double-contact lines).
+    kt = report["knot_type"]
+    ideal = ideal_report(kt, 1.0)
+    ideal = None if ideal is None else aligned(report, ideal)
+    name = {"3_1": "closed trefoil 3_1", "4_1": "closed figure-eight 4_1"}.get(
+        kt, f"closed {kt} knot")
     profiles, contact = folder / CLOSED_PROFILES_PNG, folder / CONTACT_MAP_PNG
-    plot_closed_profiles(report, profiles, ideal=ideal, label=label)
-    plot_contact_map(report, contact, ideal=ideal, label=label)
+    plot_closed_profiles(report, profiles, ideal=ideal, label=label, knot=name)
+    plot_contact_map(report, contact, ideal=ideal, label=label, knot=name)
     return [profiles, contact]
 
 

@@ -77,6 +77,8 @@ _TIE_EXAMPLES = """examples:
   tightknot tie clasp --force 1                          # two rods: tightknot tie clasp --help
   tightknot tie bend --kind reef                         # reef, granny, thief, grief
   tightknot tie open --knot 5_2 --force 1
+  tightknot tie --start knot.csv --closed --l0-over-d0 24 --units mm   # your own curve
+  tightknot tie --start overhand.txt --open --force 1    # its type is detected and kept
   tightknot tie --config runs/tight/config.json --out runs/tight-again   # rerun a run
   tightknot tie --config runs/tight/config.json --nodes 400              # ... with a change
 
@@ -99,7 +101,10 @@ def tie_config(args: argparse.Namespace):
     from tightknot.loading.options import LOADS
 
     data: dict = load_config(args.config).to_dict() if args.config is not None else {}
-    knot = args.knot if args.knot is not None else data.get("knot")
+    flag = getattr(args, "knot_flag", None)  # --closed / --open (with --start)
+    if flag is not None and args.knot is not None and flag != args.knot:
+        raise ValueError(f"--{flag} contradicts the knot {args.knot}")
+    knot = args.knot or flag or data.get("knot")
     if knot is None:
         raise ValueError("give the knot (closed or open) or --config FILE")
     if "knot" in data:
@@ -122,7 +127,7 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     from tightknot.app.progress import Progress, phase_progress
     from tightknot.app.run_folder import plan_outputs, write_centerline
     from tightknot.atomic import write_json_atomic
-    from tightknot.knots.ideal import load_ideal_trefoil
+    from tightknot.knots.ideal import has_ideal, load_ideal
     from tightknot.study.params import build_scene
     from tightknot.study.run import draw_figures, run_knot
     from tightknot.viz.rerun_log import make_logger
@@ -141,10 +146,11 @@ def _cmd_tie(args: argparse.Namespace) -> int:
     write_json_atomic(outs.config, cfg.to_dict())
     bar = Progress(scene.name, enabled=False if args.quiet else None)
     with make_logger(outs.rrd) as log:
-        if scene.closed and scene.knot_type == "3_1":
-            ideal = load_ideal_trefoil(scene.diameter)
+        if scene.closed and has_ideal(scene.knot_type):
+            ideal = load_ideal(scene.knot_type, scene.diameter)
             # Beside the rod (6 D0 below), so that both stay visible.
-            log.log_reference("ideal_trefoil",
+            log.log_reference("ideal_trefoil" if scene.knot_type == "3_1"
+                              else f"ideal_{scene.knot_type}",
                               ideal - ideal.mean(axis=0) + [0.0, 0.0, -6 * scene.diameter],
                               scene.diameter / 2)
         with bar:
@@ -348,6 +354,11 @@ def build_parser() -> argparse.ArgumentParser:
     for name, par in params.items():
         if name != "knot":
             p.add_argument(*flags(par), **flag_kwargs(par))
+    closed_open = p.add_mutually_exclusive_group()
+    for kind in ("closed", "open"):
+        closed_open.add_argument(f"--{kind}", dest="knot_flag", action="store_const",
+                                 const=kind, help=f"the knot is {kind} (as the positional "
+                                 f"{kind}; reads well with --start)")
     p.add_argument("--out", metavar="DIR", help="run folder (default runs/<scene>-<UTC time>; "
                    "made with its parents under runs/, elsewhere its parent must exist)")
     p.add_argument("--json", metavar="FILE", help="write the summary here instead")

@@ -27,9 +27,11 @@ from tightknot.study.params import (
     SCENE_NAMES,
     Output,
     Scene,
+    StartFile,
     check_scene,
     knot_defaults,
     resolve_nodes,
+    resolve_start,
 )
 
 __all__ = ["COLOR_ALIASES", "COLOR_FIELDS", "TieConfig", "config_from_dict", "config_keys",
@@ -37,10 +39,11 @@ __all__ = ["COLOR_ALIASES", "COLOR_FIELDS", "TieConfig", "config_from_dict", "co
 
 
 @dataclass(frozen=True)
-class TieConfig(Output, LoadPath, Scene):
-    """Parameters of one tie run (SI units): its scene, load path and outputs (the fields of
-    :class:`~tightknot.study.params.Scene`, :class:`~tightknot.loading.options.LoadPath` and
-    :class:`~tightknot.study.params.Output`, in that order).
+class TieConfig(Output, LoadPath, StartFile, Scene):
+    """Parameters of one tie run (SI units): its scene, start curve, load path and outputs
+    (the fields of :class:`~tightknot.study.params.Scene`,
+    :class:`~tightknot.study.params.StartFile`, :class:`~tightknot.loading.options.LoadPath`
+    and :class:`~tightknot.study.params.Output`, in that order).
 
     ``tighten_steps``, ``pull_steps`` and ``relax_iterations`` drive
     :func:`tightknot.loading.tie.tie` (closed knots; open knots pulled by ``force`` or to
@@ -56,6 +59,10 @@ class TieConfig(Output, LoadPath, Scene):
     @property
     def scene_name(self) -> str:
         """Name of the scene this config ties (e.g. ``closed_trefoil``, ``open_figure_eight``)."""
+        if self.start is not None:
+            # A detected type may read "8_20|3_1#3_1" or "unknown(det=9)": a folder name.
+            kt = "".join(c if c.isalnum() or c == "_" else "-" for c in self.knot_type)
+            return f"{self.knot}_start_{kt.strip('-')}"
         return f"{self.knot}_{SCENE_NAMES[self.knot_type]}"
 
     def tie_options(self) -> dict[str, Any]:
@@ -95,7 +102,10 @@ def config_from_dict(data: dict[str, Any]) -> TieConfig:
                          f"{', '.join(_PARAMS)}")
     if "knot" not in data:
         raise ValueError("knot: missing (closed or open)")
-    clean = {k: _PARAMS[k].check(v) for k, v in data.items()}
+    start = data.get("start") is not None
+    # A start curve's knot type is any the topology names (checked against the curve).
+    clean = {k: _start_knot_type(v) if start and k == "knot_type" else _PARAMS[k].check(v)
+             for k, v in data.items()}
     knot = clean["knot"]
     if knot == "closed":
         given = [k for k in _OPEN_ONLY if clean.get(k) is not None]
@@ -106,7 +116,17 @@ def config_from_dict(data: dict[str, Any]) -> TieConfig:
         if len(loads) != 1:
             raise ValueError("an open knot needs exactly one of force [N], end_distance [m] or "
                              f"target_lambda; got {', '.join(loads) or 'none'}")
-    for key, value in knot_defaults(knot, clean.get("knot_type", Scene.knot_type)).items():
+    if not start:
+        given = [k for k in ("units", "columns") if clean.get(k) is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)}: for a start curve only (give start FILE)")
+    if start:
+        clean.update(resolve_start(clean))
+        defaults = {k: v for k, v in knot_defaults(knot).items()
+                    if k not in ("l0_over_d0", "length")}
+    else:
+        defaults = knot_defaults(knot, clean.get("knot_type", Scene.knot_type))
+    for key, value in defaults.items():
         if clean.get(key) is None:
             clean[key] = value
     if clean.get("nodes") is None:
@@ -117,10 +137,20 @@ def config_from_dict(data: dict[str, Any]) -> TieConfig:
     return TieConfig(**clean)
 
 
+def _start_knot_type(value: Any) -> str:
+    from tightknot.knots.start_curve import is_knot_name
+
+    if not (isinstance(value, str) and is_knot_name(value)):
+        raise ValueError(f"knot_type: {value!r} is not a knot type the knot table names "
+                         "(e.g. 5_2, 8_20|3_1#3_1, unknown(det=9))")
+    return value
+
+
 def knot_specific(old: tuple[str, str], new: tuple[str, str]) -> set[str]:
     """Keys of a config for the knot ``old`` = (knot, knot_type) that do not carry over to
     ``new``: the per-knot defaults that differ, and on another knot those of one knot only."""
-    a, b = KNOT_DEFAULTS[old], KNOT_DEFAULTS[new]
+    # (a start curve's detected type has no per-knot defaults of its own)
+    a, b = KNOT_DEFAULTS.get(old, {}), KNOT_DEFAULTS.get(new, {})
     keys = {k for k in a.keys() | b.keys() if a.get(k) != b.get(k)}
     if old != new:
         keys.add("nodes")  # a resolution of the old knot's rod, whose length follows it

@@ -19,7 +19,11 @@ outputs, named so). Modules:
 - ``closed_measures``: ``barycenter``, ``threefold_axis``, ``lay_flat``,
   ``closed_knot_profile``.  ``open_measures``: ``open_knot_measures``.
 - ``measure``: ``analyze_centerline`` (all of the above on one centerline, as JSON).
-- ``ideal``: ``load_ideal_trefoil``, ``load_ideal_curvature_profile``.
+- ``ideal``: ``load_ideal`` (the shipped ideal knots ``IDEAL_KNOTS``: 3_1, 4_1, 5_1, 6_1,
+  8_19), ``load_ideal_trefoil``, ``load_ideal_curvature_profile``. ``ideal_overlay``:
+  ``ideal_report``, ``aligned`` (an ideal knot placed on a knot's s axis).
+- ``start_curve``: a user's start curve (``read_start_curve``, ``closed_from_curve``,
+  ``open_from_curve``; ``tightknot tie --start``).
 - ``centerline_io``: ``read_centerline``, ``parse_centerline_text``, ``write_centerline_csv``,
   ``CenterlineError``.
 - ``figures``: ``plot_closed_profiles``, ``plot_contact_map``, ``plot_open_knots``.
@@ -33,7 +37,9 @@ curvature_spikes (list of {s_start, s_end, s_peak, kappa_peak}), n_curvature_spi
 With smoothing: smooth_n_gauss, resample_step, smooth_window_points, length_before_smoothing.
 Closed (arrays ordered by s): vertex_order, S_sorted, kappa_D0_sorted, rho, z, X_over_D0,
 Y_over_D0, origin_S, axis, barycenter, inplane_spread_ratio, outer_segments_s,
-inner_segments_s, double_contact_fraction. Open (arrays in vertex order): Lambda_OC,
+inner_segments_s, double_contact_fraction, threefold ({applied, reason}: the 3-fold measures
+rho, z, X, Y, axis, the segments and the spread ratio are those of a trefoil; on any other
+knot they are null and s runs from vertex 0). Open (arrays in vertex order): Lambda_OC,
 contact_S1, contact_S2, S_mid.
 """
 

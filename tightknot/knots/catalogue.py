@@ -8,7 +8,7 @@ knot of that type) is the curve cut at its outermost point with straight tails a
 axis, as the study's open trefoil is built (:func:`tightknot.knots.curves._open_from_closed`).
 
 The tight length of a knot, L/D of its ideal (tightest rigid tube) shape, is that of the
-ideal polygon where one is known (:data:`IDEAL_L_OVER_D`), else an estimate:
+shipped ideal polygon where there is one (:data:`IDEAL_L_OVER_D`), else an estimate:
 L/D ~ k c^(3/4) with c the crossing number, the growth of the ropelength bound of Buck and
 Simon (1999), and k the largest (L/D) / c^(3/4) of the knots whose ideal is known, so that
 the estimate errs on the long (reachable) side for them all.
@@ -24,12 +24,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tightknot.knots import curves, families
+from tightknot.knots.ideal import IDEAL_KNOTS
 from tightknot.knots.knot_table import crossings
 
-#: L/D of the ideal closed knots: trefoil 16.3715 (Przybyl & Pieranski 2014), figure-eight
-#: 21.0415 (Ashton, Cantarella, Piatek, Rawdon 2011).
-IDEAL_L_OVER_D: Mapping[str, float] = types.MappingProxyType({"3_1": 16.3715,
-                                                              "4_1": 21.0415})
+#: L/D of the ideal closed knots: those measured on the shipped ideal polygons of Ashton,
+#: Cantarella, Piatek, Rawdon 2011 (:data:`tightknot.knots.ideal.IDEAL_KNOTS`: 3_1, 4_1,
+#: 5_1, 6_1, 8_19).
+IDEAL_L_OVER_D: Mapping[str, float] = types.MappingProxyType(
+    {k: v.l_over_d for k, v in IDEAL_KNOTS.items()})
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tightknot.knots._arclength import as_points, total_length, vertex_arclength
-from tightknot.knots.closed_measures import closed_knot_profile
+from tightknot.knots.closed_measures import barycenter, closed_knot_profile
 from tightknot.knots.contact_map import contact_pairs, double_contact_fraction
 from tightknot.knots.curvature import bergou_curvature, find_spikes
 from tightknot.knots.curves import exclusion_arc_length, min_nonlocal_distance, resample_uniform
@@ -31,6 +31,18 @@ from tightknot.knots.topology import (
 #: The study's resampling step relative to D0: N_b = 984 points on L0 = 139.1 mm gives
 #: 0.1414 mm = D0 / 60 for D0 = 8.5 mm (Johanns et al. 2021; within their 0.1 to 0.15 mm).
 STUDY_STEP_OVER_D0 = 1.0 / 60.0
+
+
+#: The knot type whose 3-fold axis the closed measures rho, z, the origin of s and the
+#: inner/outer segments are taken about (Johanns et al. 2021 define them for the trefoil).
+THREEFOLD_KNOT = "3_1"
+
+
+def threefold_reason(knot_type: str) -> str:
+    """Why a closed curve of ``knot_type`` (not a trefoil) gets no 3-fold measures."""
+    return (f"rho, z, the origin of s and the inner/outer segments are measured about a "
+            f"trefoil's 3-fold axis (Johanns et al. 2021); this curve is {knot_type}: s runs "
+            "from vertex 0, rho, z and the segments are null")
 
 
 def reduced_diameter(diameter: float, length: float, rest_length: float, poisson: float) -> float:
@@ -126,7 +138,20 @@ def analyze_centerline(
     ci, cj = contact_pairs(p, closed, a, tol=contact_tol)
     out["contact_tol"] = contact_tol
     out["spike_threshold_kappa_D0"] = spike_threshold
-    if closed:
+    if closed and out["knot_type"] != THREEFOLD_KNOT:
+        # No 3-fold axis to measure about: arc length from vertex 0, rho/z/segments null.
+        s_v = S * (l0 / (length * d0))
+        out.update(
+            s=_list(s_v), vertex_order=list(range(n)), S_sorted=_list(S),
+            kappa_D0_sorted=_list(kappa), rho=None, z=None, X_over_D0=None, Y_over_D0=None,
+            origin_S=0.0, axis=None, barycenter=_list(barycenter(p)),
+            inplane_spread_ratio=None, outer_segments_s=None, inner_segments_s=None,
+            contact_s=_list(s_v[ci]), contact_sigma=_list(s_v[cj]),
+            double_contact_fraction=double_contact_fraction(p, True, d0, double_contact_tol),
+            threefold={"applied": False, "reason": threefold_reason(out["knot_type"])},
+        )
+        spikes = find_spikes(kappa, s_v, spike_threshold, closed=True)
+    elif closed:
         prof = closed_knot_profile(p, d0, l0)
         order = prof.pop("order")
         rank = np.empty(n, dtype=np.int64)
@@ -144,6 +169,7 @@ def analyze_centerline(
             inner_segments_s=prof["inner_segments_s"],
             contact_s=_list(s_vertex[ci]), contact_sigma=_list(s_vertex[cj]),
             double_contact_fraction=double_contact_fraction(p, True, d0, double_contact_tol),
+            threefold={"applied": True, "reason": "the curve is a trefoil (3_1)"},
         )
         spikes = find_spikes(kappa[order], prof["s"], spike_threshold, closed=True)
     else:

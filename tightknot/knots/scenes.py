@@ -494,12 +494,24 @@ def closed_knot(
     device: str = "cpu",
     clearance: float = 1.02,
     contact: str = "compliant",
+    start_shape: str = "parametric",
 ) -> KnotScene:
     """A closed knot of any built-in type (:mod:`tightknot.knots.catalogue`) of rest length
     L0 = ``l0_over_d0`` D0 (default :func:`default_l0_over_d0`), joined with no excess twist,
     no external load: the trefoil and figure-eight are :func:`closed_trefoil` and
-    :func:`closed_figure_eight`, the others the same scene from their own start curve."""
+    :func:`closed_figure_eight`, the others the same scene from their own start curve.
+
+    ``start_shape``: "parametric" (those start curves) or "ideal": the shipped ideal polygon
+    of the type (:data:`tightknot.knots.ideal.IDEAL_KNOTS`), resampled, scaled to L0 and
+    grown until the tube D0 fits as every start is (so at L0 near the ideal L/D the rod
+    starts a few per cent longer than L0, already in the tight shape)."""
     l0_over_d0 = default_l0_over_d0(knot_type) if l0_over_d0 is None else l0_over_d0
+    if start_shape not in START_SHAPES:
+        raise ValueError(f"start_shape must be one of {', '.join(START_SHAPES)}, got "
+                         f"{start_shape!r}")
+    if start_shape == "ideal":
+        return _closed_ideal(knot_type, l0_over_d0, diameter, nodes, material, law, twist,
+                             device, clearance, contact)
     if knot_type == "3_1":
         return closed_trefoil(l0_over_d0, diameter, nodes, material, law, twist, device,
                               clearance, contact)
@@ -515,6 +527,31 @@ def closed_knot(
                          material, law, twist, contact, device, clearance)
     scene.rebuild = lambda n: closed_knot(knot_type, l0_over_d0, diameter, n, material, law,
                                           twist, device, clearance, contact)
+    return scene
+
+
+#: Start curves of a closed built-in knot (:func:`closed_knot`).
+START_SHAPES = ("parametric", "ideal")
+
+
+def _closed_ideal(knot_type: str, l0_over_d0: float, diameter: float, nodes: int | None,
+                  material: Material | None, law: RadialComplianceLaw | None, twist: bool,
+                  device: str, clearance: float, contact: str) -> KnotScene:
+    """:func:`closed_knot` started from the shipped ideal polygon of ``knot_type``."""
+    from tightknot.knots.ideal import load_ideal
+
+    curve = load_ideal(knot_type)  # ValueError naming the shipped knots
+    ratio = _check_ratio(l0_over_d0, knot_type)
+    nodes = default_nodes(ratio, True) if nodes is None else nodes
+    d0 = _check_common(diameter, nodes, 24)
+    twist, contact = check_twist(twist), check_contact(contact, law)
+    name = {"3_1": "closed_trefoil", "4_1": "closed_figure_eight"}.get(
+        knot_type, f"closed_{knot_type}")
+    scene = _closed_knot(name, knot_type, curve, ratio, d0, nodes, material, law, twist,
+                         contact, device, clearance)
+    scene.info["start_shape"] = "ideal"
+    scene.rebuild = lambda n: _closed_ideal(knot_type, l0_over_d0, diameter, n, material, law,
+                                            twist, device, clearance, contact)
     return scene
 
 
@@ -566,9 +603,13 @@ def default_l0_over_d0(knot_type: str) -> float:
     """Default L0/D0 of a closed knot: the study's 16.37 for the trefoil, and for the others
     5 % above the ideal L/D (:func:`tightknot.knots.catalogue.ideal_l_over_d`, known or
     estimated), rounded up to 0.1, as the figure-eight's 22.1: reachable by a rod that
-    stretches and squeezes a little, as the trefoil's does at its ideal length."""
+    stretches and squeezes a little, as the trefoil's does at its ideal length. The
+    figure-eight keeps its scene's :data:`FIGURE_EIGHT_L0_OVER_D0` (4.997 % above the
+    21.0483 measured on the shipped ideal polygon, which the rule would round to 22.2)."""
     if knot_type == "3_1":
         return 16.37
+    if knot_type == "4_1":
+        return FIGURE_EIGHT_L0_OVER_D0
     builtin(knot_type)
     return math.ceil(10.0 * 1.05 * ideal_l_over_d(knot_type)[0] - 1e-9) / 10.0
 

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from tightknot.knots.catalogue import KNOT_NAMES
 from tightknot.knots.scenes import (
     DEFAULT_EDGE_D0,
+    START_SHAPES,
     default_l0_over_d0,
     default_nodes,
     default_open_length,
@@ -130,6 +131,28 @@ class Scene:
 
 
 @dataclass(frozen=True)
+class StartFile:
+    """The user's own start curve of a ``tie`` run (:mod:`tightknot.knots.start_curve`): a
+    centerline file read as ``tightknot analyze`` reads it, closed or open as the run's knot
+    says. Its knot type is detected (``knot_type`` must match it when given)."""
+
+    start: str | None = param(None, None, "", "start curve: a centerline file (the reader of "
+                              "tightknot analyze), tied from its own shape and length; its "
+                              "knot type is detected and kept", metavar="FILE")
+    units: str | None = param(None, None, "", "unit of the start file's coordinates: m, cm, "
+                              "mm, um or metres per file unit (the run's own lengths stay SI)",
+                              default_text="the header's unit, else m", metavar="UNIT")
+    columns: str | None = param(None, None, "", "the start file's x,y,z columns: 1-based "
+                                "numbers (2,3,4) or header names",
+                                default_text="as tightknot analyze picks them",
+                                metavar="X,Y,Z")
+    start_shape: str = param("parametric", START_SHAPES, "",
+                             "start of a built-in closed knot: its family's parametric curve, "
+                             "or the shipped ideal polygon (3_1, 4_1, 5_1, 6_1, 8_19; "
+                             "tightknot.knots.ideal)", only="closed")
+
+
+@dataclass(frozen=True)
 class Output:
     """What a run writes besides its numbers, and where it runs."""
 
@@ -139,9 +162,10 @@ class Output:
                                default_text="cpu")
 
 
-#: Every run parameter by name: the scene's, the load path's and the outputs'.
-RUN_PARAMS = types.MappingProxyType({**parameters(Scene), **parameters(LoadPath),
-                                     **parameters(Output)})
+#: Every run parameter by name: the scene's, the start curve's, the load path's and the
+#: outputs'.
+RUN_PARAMS = types.MappingProxyType({**parameters(Scene), **parameters(StartFile),
+                                     **parameters(LoadPath), **parameters(Output)})
 
 
 def knot_defaults(knot: str, knot_type: str = "3_1") -> dict[str, Any]:
@@ -168,12 +192,57 @@ def check_scene(values: Mapping[str, Any]) -> None:
         p = RUN_PARAMS["nodes"]
         raise ValueError(f"nodes: {nodes!r} is out of range for {knot} knots; valid: "
                          f"[{MIN_NODES[knot]}, {p.valid.high:g}] ({p.meaning})")
+    shape = values.get("start_shape", StartFile.start_shape)
+    if shape != "parametric":
+        from tightknot.knots.ideal import IDEAL_KNOTS
+
+        kt = values.get("knot_type", Scene.knot_type)
+        if knot != "closed" or values.get("start") is not None or kt not in IDEAL_KNOTS:
+            raise ValueError(f"start_shape {shape}: for a closed built-in knot whose ideal "
+                             f"shape is shipped ({', '.join(IDEAL_KNOTS)}), without start")
     length = values.get("length")
     if knot == "open" and length is not None:
         d0 = values.get("diameter", Scene.diameter)
         if length < 10.0 * d0:
             raise ValueError(f"length must be >= 10 D0 = {10 * d0:.4g} m for an open knot, got "
                              f"{length!r}")
+
+
+def read_start(values: Mapping[str, Any]):
+    """The start curve of a run whose ``start`` is given
+    (:func:`tightknot.knots.start_curve.read_start_curve`); ValueError naming the file."""
+    from tightknot.knots.centerline_io import parse_columns
+    from tightknot.knots.start_curve import read_start_curve
+
+    columns = values.get("columns")
+    return read_start_curve(values["start"], values["knot"] == "closed", values.get("units"),
+                            None if columns is None else parse_columns(columns))
+
+
+def resolve_start(values: Mapping[str, Any]) -> dict[str, Any]:
+    """The per-knot parameters of a run from a start curve (``values``: the checked
+    parameters given, ``start`` among them): its knot type as detected (a ``knot_type``
+    given must be among its candidates), and the rest length (``l0_over_d0`` or ``length``)
+    when not given (:func:`tightknot.knots.start_curve.default_rest_length`). ValueError
+    naming the file: unreadable, intersecting itself, another knot type."""
+    from tightknot.knots import start_curve
+
+    curve = read_start(values)
+    d0 = values.get("diameter", Scene.diameter)
+    start_curve.check_no_intersection(curve, d0)
+    detected = start_curve.detect_knot_type(curve)
+    if not start_curve.is_knot_name(detected):
+        # "undefined ...": no generic projection, the curve nearly passes through itself.
+        raise start_curve.StartCurveError(f"{curve.source}: its knot type cannot be "
+                                          f"determined: {detected}")
+    start_curve.check_knot_type(curve, detected, values.get("knot_type"))
+    # The scene keeps the detected name: the topology checks compare it at every step.
+    out: dict[str, Any] = {"knot_type": detected}
+    key = "l0_over_d0" if curve.closed else "length"
+    if values.get(key) is None:
+        length = start_curve.default_rest_length(curve, detected, d0)
+        out[key] = length / d0 if curve.closed else length
+    return out
 
 
 def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
@@ -183,10 +252,25 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     from tightknot.rods.material import Material
 
     material = Material(values["youngs_modulus"], values["poisson"], values["density"])
+    if values.get("start") is not None:
+        from tightknot.knots import start_curve
+
+        curve = read_start(values)
+        if curve.closed:
+            return start_curve.closed_from_curve(
+                curve, values["knot_type"], values["l0_over_d0"], values["diameter"],
+                values["nodes"], material, twist=values["twist"], device=device,
+                contact=values["contact"])
+        return start_curve.open_from_curve(
+            curve, values["knot_type"], values["length"], values["diameter"], values["nodes"],
+            material, twist=values["twist"], device=device, contact=values["contact"],
+            grip_length=values["grip_length"], grip_twist=values["grip_twist"])
     make = scenes.closed_knot if values["knot"] == "closed" else scenes.open_knot
     length = values["l0_over_d0"] if values["knot"] == "closed" else values["length"]
     grips = ({"grip_length": values["grip_length"], "grip_twist": values["grip_twist"]}
              if values["knot"] == "open" else {})
+    shape = ({"start_shape": values.get("start_shape", StartFile.start_shape)}
+             if values["knot"] == "closed" else {})
     return make(values["knot_type"], length, values["diameter"], values["nodes"], material,
                 twist=values["twist"],
-                contact=values["contact"], device=device, **grips)
+                contact=values["contact"], device=device, **grips, **shape)

@@ -16,7 +16,7 @@ import numpy as np
 
 from tightknot.contact.report import ContactReport, contact_report
 from tightknot.knots.curvature import bergou_curvature
-from tightknot.knots.ideal import load_ideal_trefoil
+from tightknot.knots.ideal_overlay import aligned, ideal_report
 from tightknot.knots.measure import analyze_centerline
 from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import KnotScene, vertex_radii
@@ -189,13 +189,41 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
     }
     out.update(calibration_range(scene, contact))
     if scene.closed:
-        out["rho"] = np.asarray(rep["rho"]).tolist()
-        out["z"] = np.asarray(rep["z"]).tolist()
+        # Null with the reason in "threefold" where the knot has no trefoil's 3-fold axis.
+        out["rho"] = None if rep["rho"] is None else np.asarray(rep["rho"]).tolist()
+        out["z"] = None if rep["z"] is None else np.asarray(rep["z"]).tolist()
+        out["threefold"] = rep["threefold"]
+        out["ideal"] = ideal_reference(rep["knot_type"])
     else:
         lam = rep.get("Lambda_OC")
         out["lambda_oc"] = None if lam is None or not np.isfinite(lam) else float(lam)
         out["pull_force_N"] = float(res.pull_force_N)
     return out
+
+
+def ideal_reference(knot_type: str) -> dict[str, Any]:
+    """The ideal (tightest) form of a closed knot of ``knot_type``: its L/D and where that
+    comes from (measured on the shipped ideal polygon, estimated from the crossing number,
+    or none for a type the table cannot size), and whether its shape is shipped (then the
+    figures overlay it)."""
+    from tightknot.knots.catalogue import ideal_l_over_d
+    from tightknot.knots.ideal import has_ideal
+
+    try:
+        value, known = ideal_l_over_d(knot_type)
+    except ValueError:  # "unknown(det=..)", candidates "a|b": no crossing number
+        return {"L_over_D": None, "source": f"none: {knot_type} has no crossing number",
+                "shape_shipped": False}
+    source = ("measured on the shipped ideal polygon (Ashton et al. 2011)" if known
+              else "estimated from the crossing number (tightknot.knots.catalogue)")
+    return {"L_over_D": value, "source": source, "shape_shipped": has_ideal(knot_type)}
+
+
+def knot_title(closed: bool, knot_type: str) -> str:
+    """A knot's name in figure titles: 'closed trefoil 3_1', 'open figure-eight 4_1',
+    'closed 5_2 knot' (by its measured type, not the scene's name)."""
+    common = {"3_1": "trefoil 3_1", "4_1": "figure-eight 4_1"}
+    return f"{'closed' if closed else 'open'} {common.get(knot_type, f'{knot_type} knot')}"
 
 
 def calibration_range(scene: KnotScene, contact: ContactReport) -> dict[str, Any]:
@@ -291,6 +319,10 @@ def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
     # What the mesh costs in accuracy, so a coarse run says so (the trade-off study's numbers);
     # its warning stays in this entry: "warnings" are about the contact law's validity.
     summary["resolution"] = resolution_note(scene.closed, scene.model.vertex_count)
+    if "start" in scene.info:
+        # A user's start curve: its file, unit and size; knot_type is the type detected on
+        # it and kept at every load step.
+        summary["start_curve"] = dict(scene.info["start"])
     return KnotRun(scene, res, rep, contact, summary)
 
 
@@ -323,7 +355,7 @@ def draw_tube(run: KnotRun, path: Path, field: str = "kappa_D0") -> Path:
     what = (f"L0/D0 = {run.scene.rest_length / run.scene.diameter:.2f}" if run.scene.closed
             else f"L0 = {run.scene.rest_length * 1e3:.0f} mm, F = {s['pull_force_N']:.3g} N" + (
                 "" if s.get("lambda_oc") is None else f", Lambda_OC = {s['lambda_oc']:.2f}"))
-    title = f"{run.scene.name.replace('_', ' ')}: {what}, {s['knot_type']}"
+    title = f"{knot_title(run.scene.closed, s['knot_type'])}: {what}"
     view = (60.0, -60.0) if run.scene.closed else (70.0, -90.0)
     return render_tube(path, x, r_v, run.scene.closed, values, field, title, field_at=at,
                        view=view)
@@ -350,15 +382,20 @@ def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> 
     closed = [r for r in runs if r.scene.closed]
     opened = [r for r in runs if not r.scene.closed]
     if closed:
-        d0 = closed[0].scene.diameter
-        ideal = analyze_centerline(load_ideal_trefoil(d0), d0, True, contact_tol=0.002)
+        ideals: dict[tuple[str, float], dict | None] = {}
         for r in closed:
-            # The ideal knot overlaid is the trefoil's: another knot type is drawn alone.
-            ref = ideal if r.scene.knot_type == "3_1" else None
+            # The ideal knot of the run's own type, where its shape is shipped; another
+            # knot's is placed on the run's s by its best-matching curvature profile.
+            kt, d0 = r.report["knot_type"], r.scene.diameter
+            if (kt, d0) not in ideals:
+                ideals[(kt, d0)] = ideal_report(kt, d0)
+            ref = ideals[(kt, d0)]
+            ref = None if ref is None else aligned(r.report, ref)
             p1, p2 = folder / "closed_profiles.png", folder / "closed_contact_map.png"
             figures.plot_closed_profiles(r.report, p1, ideal=ref, label="elastic rod",
-                                         knot=r.scene.name.replace("_", " "))
-            figures.plot_contact_map(r.report, p2, ideal=ref, label="elastic rod")
+                                         knot=knot_title(True, kt))
+            figures.plot_contact_map(r.report, p2, ideal=ref, label="elastic rod",
+                                     knot=knot_title(True, kt))
             paths += [p1, p2]
     if opened:
         reps, lcs, areas = {}, {}, {}

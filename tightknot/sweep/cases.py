@@ -44,9 +44,12 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
 #: level with its own steps, ties with tie()'s relaxation, has no end-distance levels
 #: (its force levels are ``pull_force``), ties a long rod by mesh continuation from the
 #: coarse count that its vertex count implies (``default_coarse_nodes``), and writes no
-#: pictures; the device is the sweep's, not the case's.
+#: pictures; the device is the sweep's, not the case's; it sweeps the built-in knots from
+#: their parametric starts, not a user's start curve or an ideal start (``tie --start``,
+#: ``--start-shape``).
 NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
-                 "coarse_nodes", "color_by", "device")
+                 "coarse_nodes", "color_by", "device", "start", "units", "columns",
+                 "start_shape")
 #: Level lists of an open knot -> the load each level is (its range and unit).
 LEVELS = {"pull_force": "force", "target_lambda": "target_lambda"}
 LEVEL_KEYS = tuple(LEVELS)

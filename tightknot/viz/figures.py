@@ -56,33 +56,44 @@ def plot_closed_profiles(
     ideal: Mapping[str, Any] | None = None, label: str = "knot", knot: str = "closed trefoil",
 ) -> None:
     """rho(s), z(s), kappa D0 (s) of a closed knot (named ``knot`` in the title), the ideal
-    knot overlaid if given."""
-    fig, axes = plt.subplots(3, 1, figsize=(7, 8), sharex=True)
-    series = [("rho", r"$\rho = \sqrt{X^2+Y^2}/D_0$"), ("z", r"$z = Z/D_0$"),
-              ("kappa", r"$\kappa D_0$")]
+    knot overlaid if given. A knot without a trefoil's 3-fold axis (``report["rho"]`` None,
+    the reason in ``report["threefold"]``) gets the curvature panel only, its s from vertex
+    0; an ideal knot placed on it by :func:`tightknot.knots.ideal_overlay.aligned` is
+    labelled so."""
+    threefold = report.get("rho") is not None
+    series = [("rho", r"$\rho = \sqrt{X^2+Y^2}/D_0$"), ("z", r"$z = Z/D_0$")] if threefold else []
+    series.append(("kappa", r"$\kappa D_0$"))
+    fig, axes = plt.subplots(len(series), 1, figsize=(7, 8 if threefold else 3.6), sharex=True,
+                             squeeze=False)
+    axes = axes[:, 0]
+    ideal_style = dict(IDEAL_STYLE)
+    if ideal is not None and ideal.get("aligned"):
+        ideal_style["label"] = "ideal (placed by best-matching curvature)"
     for ax, (key, name) in zip(axes, series, strict=True):
-        for rep, style in ((report, {"color": COLORS[0], "label": label}), (ideal, IDEAL_STYLE)):
+        for rep, style in ((report, {"color": COLORS[0], "label": label}), (ideal, ideal_style)):
             if rep is None:
                 continue
             y = _closed_kappa(rep) if key == "kappa" else np.asarray(rep[key])
             ax.plot(rep["s"], y, **style)
         ax.set_ylabel(name)
         ax.grid(alpha=0.3)
-        for s_in in report.get("inner_segments_s", []):
+        for s_in in report.get("inner_segments_s") or []:
             ax.axvline(s_in, color="0.8", linewidth=0.8, zorder=0)
-    axes[2].axhline(2.0, color="0.5", linewidth=0.8, linestyle=":")
-    axes[2].text(axes[2].get_xlim()[0], 2.0, " active limit 2", va="bottom", color="0.4")
+    axes[-1].axhline(2.0, color="0.5", linewidth=0.8, linestyle=":")
+    axes[-1].text(axes[-1].get_xlim()[0], 2.0, " active limit 2", va="bottom", color="0.4")
     axes[0].legend(loc="upper right")
-    axes[0].set_title(f"{knot} (grey lines: inner segments)")
-    axes[2].set_xlabel(r"$s = S/L \cdot L_0/D_0$")
+    axes[0].set_title(f"{knot} (grey lines: inner segments)" if threefold else
+                      f"{knot} (no 3-fold axis: no rho, z; s from vertex 0)")
+    axes[-1].set_xlabel(r"$s = S/L \cdot L_0/D_0$")
     save_png_atomic(fig, path)
 
 
 def plot_contact_map(
     report: Mapping[str, Any], path: str | os.PathLike[str],
-    ideal: Mapping[str, Any] | None = None, label: str = "knot",
+    ideal: Mapping[str, Any] | None = None, label: str = "knot", knot: str | None = None,
 ) -> None:
-    """Contact map (s, sigma); the ideal knot's double-contact set overlaid if given.
+    """Contact map (s, sigma) of a closed knot (named ``knot`` in the title); the ideal
+    knot's double-contact set overlaid if given.
 
     For the ideal knot pass a report made with a tight ``contact_tol`` (e.g. 0.002): its
     contact set is then the double-contact lines.
@@ -98,7 +109,7 @@ def plot_contact_map(
     ax.set_xlabel(r"$s$")
     ax.set_ylabel(r"$\sigma$")
     ax.set_aspect("equal")
-    ax.set_title("contact map")
+    ax.set_title("contact map" if knot is None else f"contact map: {knot}")
     ax.legend(loc="upper left", markerscale=8)
     save_png_atomic(fig, path)
 
