@@ -186,3 +186,20 @@ def test_cli_crosscheck_writes_json(tmp_path):
     assert code == (0 if data["passed"] else 1)
     assert data["mesh"] == "coarse"
     assert data["fem_over_rod_time_ratio"] > 1.0
+
+
+def test_level_truth_reads_each_level_off_the_report(report):
+    # bench tradeoff --fem: the table is the report's own comparisons, level by level
+    from tightknot.benchmarks.level_truth import format_table, level_truth
+
+    table = level_truth(report)
+    rows = {r["level"]: r for r in table["rows"]}
+    ind = [lv["force_rel"] for lv in report["scenes"]["indent"]["comparison"]["levels"]]
+    assert rows["compliant"]["indent_force_rel"] == [min(ind), max(ind)]
+    sm = report["smoothed_contact_level"]["scenes"]["wrap"]["comparison"]["levels"]
+    assert rows["smoothed"]["wrap_line_load_rel"] == [min(lv["force_rel"] for lv in sm),
+                                                     max(lv["force_rel"] for lv in sm)]
+    assert rows["rigid"]["fem_errors"] is None and "compliance" in rows["rigid"]["reason"]
+    assert "| compliant |" in format_table(table)
+    with pytest.raises(ValueError, match="cross-check report"):
+        level_truth({"rows": []})

@@ -312,6 +312,8 @@ def plot(result: dict, path: Path) -> None:
 _EXAMPLES = """examples:
   tightknot bench tradeoff --json tradeoff.json     # also writes tradeoff.png
   tightknot bench tradeoff --quick --json quick.json
+  tightknot fem crosscheck --json xc.json && tightknot bench tradeoff --fem xc.json \
+      --levels-json bench/contact_levels_results.json     # each contact level against the FEM
 """
 
 
@@ -327,6 +329,12 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--json", metavar="FILE", help="write the result as JSON (+ FILE.png)")
     p.add_argument("--quick", action="store_true", help="a small version (a few minutes)")
+    p.add_argument("--fem", metavar="XC.json",
+                   help="instead of the sweep: each contact level against the FEM, read from "
+                   "a cross-check report (tightknot fem crosscheck --json XC.json)")
+    p.add_argument("--levels-json", metavar="CL.json",
+                   help="with --fem: the knots' cost per level (bench/contact_levels.py "
+                   "--json CL.json)")
     p.add_argument("--budget", type=float, default=None, metavar="S",
                    help="time budget per run [s] (default 60 with --quick, 180 otherwise); "
                    "a run over it is recorded as failed")
@@ -337,6 +345,10 @@ def _command(args) -> int:  # noqa: ANN001
     from tightknot.atomic import writable_file, write_json_atomic
 
     out = writable_file(args.json)
+    if args.fem is not None:
+        return _truth_command(args.fem, args.levels_json, out)
+    if args.levels_json is not None:
+        raise ValueError("--levels-json goes with --fem")
     budget = args.budget if args.budget is not None else (60.0 if args.quick else 180.0)
     if not (math.isfinite(budget) and budget > 0):
         raise ValueError(f"--budget must be finite and > 0 s, got {args.budget!r}")
@@ -352,4 +364,25 @@ def _command(args) -> int:  # noqa: ANN001
     if out is not None:
         write_json_atomic(out, result)
         plot(result, out.with_suffix(".png"))
+    return 0
+
+
+def _truth_command(fem: str, levels_json: str | None, out: Path | None) -> int:
+    """``bench tradeoff --fem XC.json``: the contact levels against the FEM."""
+    import json
+
+    from tightknot.atomic import write_json_atomic
+    from tightknot.benchmarks.level_truth import format_table, level_truth
+
+    def read(path: str, what: str) -> dict:
+        try:
+            return json.loads(Path(path).read_text())
+        except (OSError, ValueError) as exc:
+            raise ValueError(f"{what} {path}: cannot read it as JSON ({exc})") from None
+
+    table = level_truth(read(fem, "--fem"),
+                        read(levels_json, "--levels-json") if levels_json else None)
+    print(format_table(table))
+    if out is not None:
+        write_json_atomic(out, table)
     return 0

@@ -1,0 +1,127 @@
+"""Each contact level against the truth: ``tightknot bench tradeoff --fem XC.json``.
+
+The trade-off study (:mod:`tightknot.benchmarks.tradeoff`) measures every run against the
+finest rod run; this table measures the contact levels against the FEM (issue 18, part 3),
+beside what they cost, so that a user can pick a level with numbers. It reads, rather than
+reruns, two results:
+
+- a cross-check report (``tightknot fem crosscheck --json XC.json``: the FEM's indent and
+  wrap scenes on one mesh against the rod model at the compliant level, and at the smoothed
+  level in its ``smoothed_contact_level`` entry);
+- optionally the study's three knots at each level (``python bench/contact_levels.py
+  --json CL.json``: wall time and Newton iterations).
+
+Per level: the indent force's and the wrap's mid line load's error against the FEM at every
+compared load level (min and max), the largest area miss, the wrap's curvature miss, the rod
+model's time on the cross-check scenes and the FEM's time over it, and the knots' time
+relative to the compliant level. The rigid level has no row of errors: a rigid tube against
+a rigid counter-body has no contact compliance, so its force is set by the constraint and
+not by an approach the FEM could be compared at.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: What the table says of the rigid level's FEM errors.
+RIGID_REASON = ("a rigid tube has no contact compliance: against the FEM's rigid "
+                "counter-bodies its force is set by the constraint, not by an approach")
+
+
+def _range(levels: list[dict], key: str) -> list[float] | None:
+    vals = [lv[key] for lv in levels if lv.get(key) is not None]
+    return [min(vals), max(vals)] if vals else None
+
+
+def _max_abs(levels: list[dict], key: str) -> float | None:
+    vals = [abs(lv[key]) for lv in levels if lv.get(key) is not None]
+    return max(vals) if vals else None
+
+
+def _scene_errors(scenes: dict[str, Any]) -> dict[str, Any]:
+    ind = scenes["indent"]["comparison"]["levels"]
+    wr = scenes["wrap"]["comparison"]["levels"]
+    return {
+        "indent_force_rel": _range(ind, "force_rel"),
+        "indent_area_points_max": _max_abs(ind, "area_points"),
+        "wrap_line_load_rel": _range(wr, "force_rel"),
+        "wrap_area_points_max": _max_abs(wr, "area_points"),
+        "wrap_curvature_rel_max": _max_abs(wr, "curvature_rel"),
+        "compared_levels": {"indent": len(ind), "wrap": len(wr)},
+    }
+
+
+def _knot_cost(contact_levels: dict | None, level: str) -> dict[str, Any] | None:
+    if contact_levels is None:
+        return None
+    rows = contact_levels.get("rows", [])
+    mine = [r for r in rows if r.get("level") == level]
+    base = {r["case"]: r for r in rows if r.get("level") == "compliant"}
+    if not mine:
+        return None
+    ratios = [r["wall_time_s"] / base[r["case"]]["wall_time_s"] for r in mine
+              if r["case"] in base and base[r["case"]]["wall_time_s"] > 0]
+    return {"cases": [r["case"] for r in mine],
+            "all_converged": all(r.get("converged") for r in mine),
+            "wall_time_s": sum(r["wall_time_s"] for r in mine),
+            "time_ratio_to_compliant": [min(ratios), max(ratios)] if ratios else None}
+
+
+def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None
+                ) -> dict[str, Any]:
+    """The table (module docstring) from a cross-check report and, optionally, the contact
+    levels' knot benchmark. Raises ValueError when ``crosscheck`` is not a cross-check
+    report."""
+    if not isinstance(crosscheck, dict) or "scenes" not in crosscheck \
+            or "smoothed_contact_level" not in crosscheck:
+        raise ValueError("not a cross-check report (tightknot fem crosscheck --json F): it "
+                         "needs 'scenes' and 'smoothed_contact_level'")
+    fem_time = crosscheck["fem_wall_time_s"]
+    sm = crosscheck["smoothed_contact_level"]
+    rows = [
+        {"level": "compliant", **_scene_errors(crosscheck["scenes"]),
+         "rod_wall_time_s": crosscheck["rod_wall_time_s"],
+         "fem_over_rod_time_ratio": crosscheck["fem_over_rod_time_ratio"],
+         "passed": crosscheck["passed"], "knots": _knot_cost(contact_levels, "compliant")},
+        {"level": "smoothed", **_scene_errors(sm["scenes"]),
+         "rod_wall_time_s": sm["rod_wall_time_s"],
+         "fem_over_rod_time_ratio": sm["fem_over_rod_time_ratio"],
+         "passed": sm["passed"], "knots": _knot_cost(contact_levels, "smoothed")},
+        {"level": "rigid", "fem_errors": None, "reason": RIGID_REASON,
+         "knots": _knot_cost(contact_levels, "rigid")},
+    ]
+    return {"fem_mesh": crosscheck.get("mesh"), "fem_wall_time_s": fem_time,
+            "targets": crosscheck.get("targets"), "rows": rows,
+            "not_covered": "two soft rods (the FEM's soft_crossing: the compliant and smoothed "
+                           "levels' pair law carries 0.55 to 0.66 of its force at the same "
+                           "per-rod approach, docs/fem_nip.md) and the sectioned level (not "
+                           "built; docs/sectioned_level.md)"}
+
+
+def _pct(r: list[float] | None) -> str:
+    return "n/a" if r is None else f"{100 * r[0]:+.1f} .. {100 * r[1]:+.1f} %"
+
+
+def format_table(table: dict[str, Any]) -> str:
+    """Markdown table of :func:`level_truth`'s result."""
+    lines = [f"contact levels against the FEM ({table['fem_mesh']} mesh, "
+             f"{table['fem_wall_time_s']:.0f} s of FEM)",
+             "| level | indent force | wrap line load | area, max [points] | wrap curvature, "
+             "max | rod time [s] | FEM / rod time | knots' time / compliant |",
+             "|---|---|---|---|---|---|---|---|"]
+    for row in table["rows"]:
+        knots = row.get("knots")
+        kt = ("n/a" if not knots or knots["time_ratio_to_compliant"] is None else
+              f"{knots['time_ratio_to_compliant'][0]:.2f} .. "
+              f"{knots['time_ratio_to_compliant'][1]:.2f}")
+        if row["level"] == "rigid":
+            lines.append(f"| rigid | n/a ({RIGID_REASON}) | n/a | n/a | n/a | n/a | n/a | {kt} |")
+            continue
+        area = max(row["indent_area_points_max"] or 0.0, row["wrap_area_points_max"] or 0.0)
+        lines.append(
+            f"| {row['level']} | {_pct(row['indent_force_rel'])} | "
+            f"{_pct(row['wrap_line_load_rel'])} | {100 * area:.1f} | "
+            f"{100 * (row['wrap_curvature_rel_max'] or 0.0):.1f} % | "
+            f"{row['rod_wall_time_s']:.2f} | {row['fem_over_rod_time_ratio']:.0f} | {kt} |")
+    lines.append(f"not covered: {table['not_covered']}")
+    return "\n".join(lines)
