@@ -32,7 +32,14 @@ from ..material import (
 )
 from ..measure import section_area
 from ..mesh import lateral_faces, quarter_disk
-from ._common import check_common, check_positive, finite, load_schedule, relative
+from ._common import (
+    check_common,
+    check_positive,
+    convergence_table,
+    finite,
+    load_schedule,
+    relative,
+)
 from ._pair import GAP_OVER_DHAT, contact_edge, make_barrier, nodal_contact, stack
 from .squeeze import SECTION_POINTS_2D
 
@@ -40,26 +47,28 @@ HEADLINE_KEYS = ("force_per_length_over_e_d0", "half_width_over_d0", "peak_press
                  "contact_fraction_side", "area_ratio")
 """Outputs compared with the rigid-plane squeeze and across meshes."""
 
-LEVELS: tuple[str, ...] = ("coarse", "medium")
-"""Meshes of this scene (the section meshes of the plane-strain squeeze)."""
-
 
 def run(mesh: str = "coarse", max_approach_over_d0: float = 0.3, steps: int = 4,
-        compare: bool = True, dhat_over_d0: float = DHAT_OVER_D0,
+        compare: bool = True, convergence: bool = False, dhat_over_d0: float = DHAT_OVER_D0,
         diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS
         ) -> dict[str, Any]:
     """Press two soft rods together up to a total approach ``max_approach_over_d0`` D0
     (w per side is half of it); with ``compare``, run the rigid-plane plane-strain
     ``squeeze`` on the same section mesh and load levels and add ``comparison``;
-    ``dhat_over_d0`` is the barrier's activation distance over D0 (for a dhat study).
+    ``dhat_over_d0`` is the barrier's activation distance over D0 (for a dhat study);
+    ``convergence`` adds the three-mesh table (``mesh_convergence``).
     """
     check_common(mesh, max_approach_over_d0, steps)
     check_positive("diameter", diameter)
     check_positive("youngs_modulus", youngs_modulus)
     if not (isinstance(dhat_over_d0, (int, float)) and 1e-6 <= dhat_over_d0 <= 1e-2):
         raise ValueError(f"dhat_over_d0 must lie in [1e-6, 1e-2], got {dhat_over_d0!r}")
-    result = _run_one(mesh, max_approach_over_d0, steps, diameter, youngs_modulus,
-                      dhat_over_d0)
+    args = (max_approach_over_d0, steps, diameter, youngs_modulus, dhat_over_d0)
+    result = _run_one(mesh, *args)
+    result["mesh_convergence"] = (
+        convergence_table(lambda lvl: _run_one(lvl, *args), HEADLINE_KEYS, first=result,
+                          level=mesh)[0] if convergence else
+        {"computed": False, "reason": "run with convergence=True for the table"})
     if compare:
         from .squeeze import run as rigid_run
 
