@@ -10,20 +10,48 @@ import pytest
 pytest.importorskip("felupe")
 pytest.importorskip("ipctk")
 
-pytestmark = pytest.mark.slow  # about 500 s on 2 shared cores (docs/fem_nip.md)
+SLOW = pytest.mark.slow  # the coarse scene's 4 levels: about 500 s on 2 shared cores
 
 
+@pytest.fixture(scope="module")
+def small_crossing():
+    """One level at w = 0.003 D0, coarse, with the rigid indent (about 16 s)."""
+    from tightknot.fem import run_scene
+
+    return run_scene("soft_crossing", mesh="coarse", max_approach_over_d0=0.006, steps=1)
+
+
+def test_small_crossing_symmetry_and_balance(small_crossing):
+    # the cheap check of the scene's construction: B is A turned about x = z, so both
+    # rods must carry the same peak pressure and constriction (measured equal to 1e-12);
+    # the force through the barrier balances; the rods touch but do not pass through;
+    # the soft pair is stiffer than the rigid indent (2.18 here, where the coarse mesh
+    # does not resolve the patch: the level is for the construction, not the ratio)
+    step = small_crossing["steps"][0]
+    assert step["w_over_d0"] == pytest.approx(0.003)
+    assert step["peak_pressure_b_over_e"] == pytest.approx(step["peak_pressure_over_e"],
+                                                           rel=1e-6)
+    assert step["area_ratio_mid_b"] == pytest.approx(step["area_ratio_mid"], rel=1e-9)
+    assert abs(step["force_balance_rel"]) < 1e-9
+    assert 0.0 < step["min_gap_over_d0"] < small_crossing["parameters"]["dhat_over_d0"]
+    ratio = small_crossing["comparison"]["relative_difference_soft_over_rigid"][0][
+        "force_ratio_soft_over_rigid"]
+    assert ratio > 1.3
+
+
+@SLOW
 def test_soft_crossing_is_stiffer_than_the_rigid_indent(soft_crossing_coarse):
     # measured soft/rigid force at w/D0 = 0.0094, 0.0375, 0.084, 0.15 (coarse): 1.60,
     # 1.58, 1.64, 1.79, where Hertz gives sqrt(2) = 1.41 and the rod model's even split
     # 1.0; the band [1.3, 2.0] says "well above the law's 1" without pinning the numbers
-    # (the medium mesh is in docs/fem_nip.md)
+    # (medium: 1.56, 1.54 at the first two levels, docs/fem_nip.md)
     rows = soft_crossing_coarse["comparison"]["relative_difference_soft_over_rigid"]
     for row in rows:
         assert 1.3 < row["force_ratio_soft_over_rigid"] < 2.0
         assert row["hertz_ratio"] == pytest.approx(math.sqrt(2.0))
 
 
+@SLOW
 def test_patch_is_wider_by_about_sqrt2(soft_crossing_coarse):
     # Hertz: a = sqrt(2 R w) for two soft rods against sqrt(R w) on a rigid one; measured
     # soft/rigid semi-axes 1.35 to 1.55 from w = 0.0375 D0 on (the first level's patch
@@ -35,6 +63,7 @@ def test_patch_is_wider_by_about_sqrt2(soft_crossing_coarse):
             assert 1.2 < s[key] / r[key] < 1.7
 
 
+@SLOW
 def test_both_rods_see_the_same_contact(soft_crossing_coarse):
     # B is A turned about the line x = z, y = y_B/2: by that symmetry both rods carry the
     # same peak pressure and the same mid-section constriction (to the solver tolerance)
@@ -47,6 +76,7 @@ def test_both_rods_see_the_same_contact(soft_crossing_coarse):
         assert 0.0 < step["min_gap_over_d0"] < dhat
 
 
+@SLOW
 def test_profile_along_the_rod(soft_crossing_coarse):
     last = soft_crossing_coarse["steps"][-1]
     profile = last["profile_a"]
