@@ -52,9 +52,10 @@ class BarrierProblem:
     ``fixed`` is a boolean mask over the dofs (point-major); ``prescribed(t)`` returns the
     displacement [m] of every dof at load t (only the fixed entries are used);
     ``log`` (optional) is called with one line per Newton iteration (progress);
-    ``force_scale`` [N or N/m] is the force below which residuals are round-off (the
-    convergence floor is ``tol 1e-4 force_scale``, far below FElupe's default absolute 1e-3 N,
-    which stops soft-contact iterations before the patch has formed).
+    ``force_scale`` [N or N/m] sets the floor of the convergence test: the residual is
+    compared with ``tol`` times the larger of the reaction and ``1e-4 force_scale``, far
+    below FElupe's default absolute 1e-3 N, which stops soft-contact iterations before the
+    patch has formed.
     """
 
     field: Any
@@ -96,8 +97,9 @@ class BarrierProblem:
 
     def energy(self) -> float:
         """Total energy Pi [J or J/m]; inf where surfaces cross or elements invert."""
-        v, _ = self._cell_volumes()
-        if not np.all(v > 0.0):
+        # an over-long trial step can invert an element at a quadrature point while its
+        # cell volume stays positive: check J there, before FElupe's J^(-2/3)
+        if not np.all(np.linalg.det(self.field.extract()[0].T) > 0.0):
             return float("inf")
         barrier = self.contact.energy()
         if not np.isfinite(barrier):
@@ -208,8 +210,6 @@ class BarrierProblem:
         load advances by the fraction taken, and a corrector follows. The correctors at
         intermediate loads stop at ``intermediate_tol`` (the next predictor starts from
         their state and its residual is in its right-hand side), the last one at ``tol``.
-        Skipping the intermediate correctors altogether doubled the solves on the
-        two-rod squeeze (the patch then grows under more, shorter cuts).
         """
         total = 0
         for _ in range(max_predictors):
