@@ -28,3 +28,25 @@ def wrap_coarse():
     from tightknot.fem import run_scene
 
     return run_scene("wrap", mesh="coarse", convergence=False)
+
+
+@pytest.fixture(scope="session")
+def soft_squeeze_coarse():
+    """Two soft rods pressed together (barrier contact), coarse, 4 levels, with the
+    rigid-plane squeeze on the same mesh (about 4 s on 2 cores)."""
+    pytest.importorskip("felupe")
+    pytest.importorskip("ipctk")
+    from tightknot.fem import run_scene
+
+    return run_scene("soft_squeeze", mesh="coarse")
+
+
+@pytest.fixture(scope="session")
+def soft_crossing_coarse():
+    """Two soft rods crossing at 90 degrees, coarse, 4 levels, with the rigid indent
+    (about 500 s on 2 shared cores: slow tests only)."""
+    pytest.importorskip("felupe")
+    pytest.importorskip("ipctk")
+    from tightknot.fem import run_scene
+
+    return run_scene("soft_crossing", mesh="coarse")

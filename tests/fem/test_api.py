@@ -48,7 +48,7 @@ def test_bad_input_names_the_parameter(kwargs, name):
 
 
 def test_scenes_listed():
-    assert SCENES == ("squeeze", "indent", "wrap")
+    assert SCENES == ("squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing")
 
 
 def _parser():
@@ -71,6 +71,37 @@ def test_cli_fem_writes_json(tmp_path):
                                  "--approach", "0.05", "--json", str(out)])
     assert args.handler(args) == 0
     assert json.loads(out.read_text())["steps"][-1]["approach_over_d0"] == pytest.approx(0.05)
+
+
+def test_cli_soft_squeeze_writes_json(tmp_path):
+    # one level at a small approach without the rigid counterpart: about 1 s
+    pytest.importorskip("felupe")
+    pytest.importorskip("ipctk")
+    out = tmp_path / "soft.json"
+    args = _parser().parse_args(["fem", "soft_squeeze", "--steps", "1", "--no-compare",
+                                 "--approach", "0.02", "--json", str(out)])
+    assert args.handler(args) == 0
+    result = json.loads(out.read_text())
+    assert result["steps"][-1]["approach_over_d0"] == pytest.approx(0.02)
+    assert "comparison" not in result
+    assert result["mesh_convergence"]["computed"] is False
+
+
+def test_missing_ipctk_gives_hint_and_exit_2():
+    pytest.importorskip("felupe")
+    code = (
+        "import sys; sys.modules['ipctk'] = None\n"
+        "import argparse\n"
+        "from tightknot.fem.commands import register\n"
+        "p = argparse.ArgumentParser(); register(p.add_subparsers())\n"
+        "a = p.parse_args(['fem', 'soft_squeeze', '--no-compare', '--steps', '1'])\n"
+        "sys.exit(a.handler(a))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert "ipctk" in proc.stderr and 'pip install "tightknot[fem]"' in proc.stderr
+    assert proc.stderr.count("\n") == 1
 
 
 def test_cli_help_has_examples(capsys):
@@ -99,7 +130,8 @@ def test_missing_felupe_gives_hint_and_exit_2():
 
 
 def test_import_does_not_load_felupe():
-    code = "import sys, tightknot.fem, tightknot.fem.commands; print('felupe' in sys.modules)"
+    code = ("import sys, tightknot.fem, tightknot.fem.commands; "
+            "print('felupe' in sys.modules or 'ipctk' in sys.modules)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=120)
     assert proc.stdout.strip() == "False", proc.stderr

@@ -1,13 +1,14 @@
 """tightknot.fem: the small 3D solid FEM cross-check and the contact-law calibration.
 
 Nearly incompressible neo-Hookean solids (mixed u-p, Q1/P0) in FElupe with frictionless
-penalty contact against rigid plates and cylinders. FElupe is GPL-3.0 and optional
+penalty contact against rigid plates and cylinders, and barrier contact (ipctk, the IPC
+Toolkit) between two deformable rods in the ``soft_*`` scenes. FElupe is GPL-3.0 and optional
 (``pip install "tightknot[fem]"``); it is imported lazily, only when a scene runs.
 
 Public API::
 
     run_scene(name, mesh="coarse", max_approach_over_d0=None, steps=None, **options) -> dict
-    SCENES  # names of the scenes: "squeeze", "indent", "wrap"
+    SCENES  # names of the scenes: "squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing"
     calibration.calibrate(mesh="medium"), calibration.write_law(path)
     crosscheck.crosscheck(mesh="coarse")  # FEM versus rod model on indent and wrap
     commands.register(subparsers)  # CLI subcommands "fem", "calibrate", "fem crosscheck"
@@ -21,10 +22,14 @@ from typing import Any
 
 from ._backend import INSTALL_HINT, FelupeMissingError, require_felupe
 
-SCENES: tuple[str, ...] = ("squeeze", "indent", "wrap")
+SCENES: tuple[str, ...] = ("squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing")
 """Names of the implemented FEM scenes."""
 
-DEFAULT_STEPS: dict[str, int] = {"squeeze": 12, "indent": 10, "wrap": 6}
+SOFT_SCENES: tuple[str, ...] = ("soft_squeeze", "soft_crossing")
+"""Scenes with two deformable rods in barrier contact (need ipctk as well as FElupe)."""
+
+DEFAULT_STEPS: dict[str, int] = {"squeeze": 12, "indent": 10, "wrap": 6, "soft_squeeze": 4,
+                                 "soft_crossing": 4}
 """Default number of load steps per scene."""
 
 __all__ = ["SCENES", "INSTALL_HINT", "FelupeMissingError", "run_scene", "require_felupe"]
@@ -44,7 +49,9 @@ def run_scene(name: str, mesh: str = "coarse", max_approach_over_d0: float | Non
     instead); ``steps`` the number of load steps (default per scene). ``options`` go to
     the scene (squeeze: ``model`` "plane_strain" | "3d", ``ends`` "plane" | "free",
     ``length_over_d0``; wrap: ``max_tension_over_e_d0sq``, ``wrap_angle_deg``,
-    ``length_over_d0``; all: ``convergence`` (bool, default True: also run the three
+    ``length_over_d0``; soft_squeeze, soft_crossing: ``compare`` (bool, default True: also
+    run the rigid counterpart, ``squeeze`` or ``indent``), ``dhat_over_d0``; all:
+    ``convergence`` (bool, default True, False for the soft scenes: also run the three
     meshes for the ``mesh_convergence`` table), ``diameter``, ``youngs_modulus``).
 
     Result keys: ``scene``, ``mesh``, ``parameters``, ``steps`` (list of per-step dicts),
@@ -56,9 +63,10 @@ def run_scene(name: str, mesh: str = "coarse", max_approach_over_d0: float | Non
         raise ValueError(f"name must be one of {SCENES}, got {name!r}")
     if steps is None:
         steps = DEFAULT_STEPS[name]
-    from .scenes import indent, squeeze, wrap
+    from .scenes import indent, soft_crossing, soft_squeeze, squeeze, wrap
 
-    module = {"squeeze": squeeze, "indent": indent, "wrap": wrap}[name]
+    module = {"squeeze": squeeze, "indent": indent, "wrap": wrap,
+              "soft_squeeze": soft_squeeze, "soft_crossing": soft_crossing}[name]
     loads: dict[str, Any] = {}
     if name == "wrap":
         if max_approach_over_d0 is not None:

@@ -28,3 +28,20 @@ def require_felupe() -> ModuleType:
 def felupe_version() -> str:
     """Version string of the installed FElupe (raises if it is missing)."""
     return str(require_felupe().__version__)
+
+
+IPCTK_HINT = ('the two-deformable-body FEM scenes need ipctk (IPC Toolkit, MIT, optional): '
+              'pip install "tightknot[fem]"')
+
+
+def require_ipctk() -> ModuleType:
+    """Return the ``ipctk`` module, or raise :class:`FelupeMissingError` with the hint.
+
+    ipctk belongs to the same optional ``fem`` extra as FElupe, so a missing ipctk is the
+    same kind of error (an ``ImportError`` naming the extra).
+    """
+    try:
+        import ipctk
+    except ImportError as err:  # the optional extra is not installed
+        raise FelupeMissingError(IPCTK_HINT) from err
+    return ipctk

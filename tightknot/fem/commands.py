@@ -22,6 +22,8 @@ _FEM_EXAMPLES = """examples:
   tightknot fem indent --mesh coarse --no-convergence
   tightknot fem wrap --tension 0.25 --wrap-angle 90 --no-convergence
   tightknot fem crosscheck --json out/crosscheck.json   # FEM (medium) versus rod model
+  tightknot fem soft_squeeze --mesh medium      # two soft rods pressed together (barrier)
+  tightknot fem soft_crossing --json out/x.json # two soft rods crossing at 90 degrees
 """
 
 _CAL_EXAMPLES = """examples:
@@ -37,13 +39,15 @@ def register(subparsers: Any) -> None:
         description="Run a FEM contact scene of a nearly incompressible neo-Hookean rod "
                     "(E = 1.25 MPa, D0 = 8.5 mm) and print or save its JSON result.",
         epilog=_FEM_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    fem.add_argument("scene", help="squeeze | indent | wrap, or crosscheck (indent and wrap "
-                                   "with the FEM and with the rod model, compared)")
+    fem.add_argument("scene", help="squeeze | indent | wrap | soft_squeeze | soft_crossing, "
+                                   "or crosscheck (indent and wrap with the FEM and with "
+                                   "the rod model, compared)")
     fem.add_argument("--mesh", default=None,
                      help="coarse | medium | fine (default: coarse for a scene, medium for "
                           "crosscheck: the mesh the shipped law was calibrated on)")
     fem.add_argument("--approach", type=float, default=None,
-                     help="squeeze, indent: total approach over D0, in (0, 1) (default 0.3)")
+                     help="squeeze, indent, soft_*: total approach over D0, in (0, 1) "
+                          "(default 0.3)")
     fem.add_argument("--tension", type=float, default=None,
                      help="wrap only: largest end tension over E D0^2, in (0, 0.5] "
                           "(default 0.25)")
@@ -54,6 +58,11 @@ def register(subparsers: Any) -> None:
     fem.add_argument("--ends", default=None, help="squeeze 3d only: plane | free")
     fem.add_argument("--no-convergence", action="store_true",
                      help="skip the three-mesh convergence table")
+    fem.add_argument("--convergence", action="store_true",
+                     help="soft_* only: add the three-mesh table (off by default: the fine "
+                          "mesh takes about 15 minutes)")
+    fem.add_argument("--no-compare", action="store_true",
+                     help="soft_* only: skip the rigid counterpart (squeeze or indent)")
     fem.add_argument("--json", default=None, metavar="FILE",
                      help="write the result to FILE (atomically) instead of stdout")
     fem.set_defaults(handler=_run_fem)
@@ -92,7 +101,13 @@ def _run_fem(args: argparse.Namespace) -> int:
         return _fail(problem)
     if args.scene == "crosscheck":
         return _run_crosscheck(args)
-    options: dict[str, Any] = {"convergence": not args.no_convergence}
+    from . import SOFT_SCENES
+
+    if args.scene in SOFT_SCENES:
+        options: dict[str, Any] = {"convergence": args.convergence and not args.no_convergence,
+                                   "compare": not args.no_compare}
+    else:
+        options = {"convergence": not args.no_convergence}
     if args.tension is not None:
         options["max_tension_over_e_d0sq"] = args.tension
     if args.wrap_angle is not None:
