@@ -135,3 +135,18 @@ def test_import_does_not_load_felupe():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=120)
     assert proc.stdout.strip() == "False", proc.stderr
+
+
+def test_cli_failed_solve_is_one_line_and_exit_1(monkeypatch, capsys):
+    # A solve that fails is the physics, not the input: exit 1 with one line, no traceback.
+    import tightknot.fem as fem_pkg
+    from tightknot.fem.barrier_solver import BarrierNewtonFailure
+
+    def failing(*_args, **_kwargs):
+        raise BarrierNewtonFailure("no convergence in 60 iterations at load 0.5")
+
+    monkeypatch.setattr(fem_pkg, "run_scene", failing)
+    args = _parser().parse_args(["fem", "soft_crossing", "--steps", "1"])
+    assert args.handler(args) == 1
+    err = capsys.readouterr().err
+    assert "the solve failed: no convergence" in err and err.count("\n") == 1

@@ -94,7 +94,9 @@ def _check_out(path: str | None) -> str | None:
 
 def _run_fem(args: argparse.Namespace) -> int:
     from . import run_scene
+    from .barrier_solver import BarrierNewtonFailure
     from .scenes._common import finite
+    from .solver import NewtonFailure
 
     problem = _check_out(args.json)
     if problem:
@@ -122,6 +124,10 @@ def _run_fem(args: argparse.Namespace) -> int:
                            steps=args.steps, **options)
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))
+    except (NewtonFailure, BarrierNewtonFailure) as err:
+        # the physics failed, not the input: one line and exit 1 (ground rule 6)
+        print(f"tightknot fem {args.scene}: the solve failed: {err}", file=sys.stderr)
+        return 1
     if args.json is None:
         print(json.dumps(finite(result), indent=2, allow_nan=False))
     else:
