@@ -33,9 +33,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import cho_factor, cho_solve, cho_solve_banded, cholesky_banded
+from scipy.linalg import cho_solve_banded, cholesky_banded
 
 from tightknot.contact.section_modes import mode_stiffness
+from tightknot.contact.section_squeeze import minimise, rounded_penalty, shifted_cholesky_step
 
 #: Decay length l_n / D0 of mode n along a 3D rod of the FEM's solid, fine mesh
 #: (docs/sectioned_level.md, ``rod_mode_decay``). Modes above 4 were not measured: they take
@@ -140,13 +141,7 @@ class StraightSectionedRod:
         return z, blocks[:, 1:]
 
     def _penalty(self, pen: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-        k, eps = self.kappa, PENALTY_ONSET
-        g = np.maximum(pen, 0.0)
-        low = g < eps
-        phi = np.where(low, k * g**3 / (6.0 * eps), k * (0.5 * g**2 - 0.5 * eps * g + eps**2 / 6.0))
-        dphi = np.where(low, k * g**2 / (2.0 * eps), k * (g - 0.5 * eps))
-        d2phi = np.where(low, k * g / eps, k)
-        return phi, dphi, d2phi
+        return rounded_penalty(pen, self.kappa, PENALTY_ONSET)
 
     def _contact(self, lam: NDArray, zc: NDArray, a: NDArray, w: float) -> dict[str, NDArray]:
         """Penetration of every sample of every edge (edges x samples), its derivatives in
@@ -398,37 +393,16 @@ class StraightSectionedRod:
         """Equilibrium at body approach ``w`` [D0] from ``start`` (dofs of a nearby approach)."""
         if not 0.0 <= w < 0.5:
             raise ValueError(f"w must be in [0, 0.5) D0, got {w}")
-        u = np.zeros(self.ndof) if start is None else np.asarray(start, float).copy()
-        e, g, hess = self.energy(u, w)
-        for it in range(MAX_ITERATIONS):
-            if float(np.max(np.abs(g))) <= RESIDUAL_TOL:
-                return self._measure(u, w, it), u
-            d = self._newton_step(hess, g)
-            step = 1.0
-            while step > 1e-12:
-                e1, g1, h1 = self.energy(u + step * d, w)
-                tiny = abs(e1 - e) <= 1e-13 * max(abs(e), 1e-30)
-                if e1 <= e + 1e-4 * step * float(g @ d) or (
-                        tiny and np.max(np.abs(g1)) < np.max(np.abs(g))):
-                    break
-                step *= 0.5
-            else:
-                break
-            u, e, g, hess = u + step * d, e1, g1, h1
-        raise FloatingPointError(f"sectioned rod at w = {w} D0 did not converge (largest "
-                                 f"generalised force {float(np.max(np.abs(g))):.2e})")
+        u0 = np.zeros(self.ndof) if start is None else start
+        u, it = minimise(lambda u: self.energy(u, w), u0, self._newton_step, RESIDUAL_TOL,
+                         MAX_ITERATIONS, f"sectioned rod at w = {w} D0")
+        return self._measure(u, w, it), u
 
     def _newton_step(self, hess: NDArray, g: NDArray) -> NDArray:
         """-H^-1 g by banded Cholesky, H shifted to positive definite where the shrinking mean
         radius makes it indefinite."""
         if self.body == "rod":  # the crossing couples sections along the patch: dense
-            shift = 0.0
-            while True:
-                try:
-                    chol = cho_factor(hess + shift * np.eye(self.ndof))
-                    return -cho_solve(chol, g)
-                except np.linalg.LinAlgError:
-                    shift = max(2.0 * shift, 1e-8 * float(np.max(np.diag(hess))))
+            return shifted_cholesky_step(hess, g, 1e-8)
         b = self.bandwidth
         n = self.ndof
         band = np.zeros((b + 1, n))  # upper form: band[b + i - j, j] = H[i, j]

@@ -28,6 +28,7 @@ the question it answers (docs/sectioned_level.md).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,6 +50,62 @@ PENALTY_ONSET = 1e-4
 RESIDUAL_TOL = 1e-12
 #: Newton iterations before a solve is declared failed.
 MAX_ITERATIONS = 100
+
+
+def rounded_penalty(pen: NDArray, kappa: float, onset: float) -> tuple[NDArray, NDArray,
+                                                                         NDArray]:
+    """Penalty per unit boundary length phi(g) of the penetration g [D0] and its first two
+    derivatives: kappa g^2 / 2 with the first ``onset`` of penetration rounded into a cubic
+    (kappa g^3 / (6 onset)), so that the Hessian is continuous where a sample enters contact
+    and Newton converges there."""
+    g = np.maximum(pen, 0.0)
+    low = g < onset
+    phi = np.where(low, kappa * g**3 / (6.0 * onset),
+                   kappa * (0.5 * g**2 - 0.5 * onset * g + onset**2 / 6.0))
+    dphi = np.where(low, kappa * g**2 / (2.0 * onset), kappa * (g - 0.5 * onset))
+    d2phi = np.where(low, kappa * g / onset, kappa)
+    return phi, dphi, d2phi
+
+
+def shifted_cholesky_step(hess: NDArray, g: NDArray, shift_fraction: float) -> NDArray:
+    """-H^-1 g, H shifted by a multiple of the identity (doubling from ``shift_fraction`` of
+    its largest diagonal entry) until a Cholesky factorisation exists: the shrinking mean
+    radius of a section can make the Hessian indefinite."""
+    shift = 0.0
+    while True:
+        try:
+            chol = np.linalg.cholesky(hess + shift * np.eye(len(g)))
+            return -np.linalg.solve(chol.T, np.linalg.solve(chol, g))
+        except np.linalg.LinAlgError:
+            shift = max(2.0 * shift, shift_fraction * float(np.max(np.diag(hess))))
+
+
+def minimise(energy: Callable[[NDArray], tuple[float, NDArray, NDArray]], u0: NDArray,
+             step: Callable[[NDArray, NDArray], NDArray], tol: float, max_iterations: int,
+             what: str) -> tuple[NDArray, int]:
+    """Newton from ``u0`` on ``energy`` (value, gradient, Hessian) with the direction
+    ``step(hess, g)``, backtracking on the energy, or on the residual where the energy
+    change is below its round-off; converged when every generalised force is below ``tol``.
+    Returns the minimiser and the iterations; raises FloatingPointError naming ``what``."""
+    u = np.asarray(u0, dtype=float).copy()
+    e, g, hess = energy(u)
+    for it in range(max_iterations):
+        if float(np.max(np.abs(g))) <= tol:
+            return u, it
+        d = step(hess, g)
+        alpha = 1.0
+        while alpha > 1e-12:
+            e1, g1, h1 = energy(u + alpha * d)
+            tiny = abs(e1 - e) <= 1e-13 * max(abs(e), 1e-30)
+            if e1 <= e + 1e-4 * alpha * float(g @ d) or (
+                    tiny and np.max(np.abs(g1)) < np.max(np.abs(g))):
+                break
+            alpha *= 0.5
+        else:
+            break
+        u, e, g, hess = u + alpha * d, e1, g1, h1
+    raise FloatingPointError(f"{what} did not converge (largest generalised force "
+                             f"{float(np.max(np.abs(g))):.2e} after Newton)")
 
 
 @dataclass
@@ -136,17 +193,7 @@ class SectionSqueeze:
         return e, g, hess
 
     def _penalty(self, pen: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-        """Plate penalty per unit boundary length phi(g) of the penetration g and its first
-        two derivatives: kappa g^2 / 2 with the first ``onset`` of penetration rounded into a
-        cubic (kappa g^3 / (6 onset)), so that the Hessian is continuous where a sample
-        enters contact and Newton converges there."""
-        k, eps = self.kappa, self.onset
-        g = np.maximum(pen, 0.0)
-        low = g < eps
-        phi = np.where(low, k * g**3 / (6.0 * eps), k * (0.5 * g**2 - 0.5 * eps * g + eps**2 / 6.0))
-        dphi = np.where(low, k * g**2 / (2.0 * eps), k * (g - 0.5 * eps))
-        d2phi = np.where(low, k * g / eps, k)
-        return phi, dphi, d2phi
+        return rounded_penalty(pen, self.kappa, self.onset)
 
     def solve(self, w_over_d0: float, start: NDArray | None = None) -> tuple[SqueezeState,
                                                                           NDArray]:
@@ -155,36 +202,11 @@ class SectionSqueeze:
         amplitudes."""
         if not 0.0 <= w_over_d0 < 0.5:
             raise ValueError(f"w_over_d0 must be in [0, 0.5), got {w_over_d0}")
-        a = np.zeros(len(self.modes)) if start is None else np.asarray(start, float).copy()
-        e, g, hess = self.energy(a, w_over_d0)
-        for it in range(MAX_ITERATIONS):
-            if float(np.max(np.abs(g))) <= RESIDUAL_TOL:
-                return self._measure(a, w_over_d0, it), a
-            # Newton on the Hessian, shifted to positive definite where the shrinking mean
-            # radius makes it indefinite; then backtracking on the energy, or on the residual
-            # where the energy change is below its round-off.
-            shift = 0.0
-            while True:
-                try:
-                    chol = np.linalg.cholesky(hess + shift * np.eye(len(a)))
-                    break
-                except np.linalg.LinAlgError:
-                    shift = max(2.0 * shift, 1e-6 * float(np.max(np.diag(hess))))
-            d = -np.linalg.solve(chol.T, np.linalg.solve(chol, g))
-            step = 1.0
-            while step > 1e-12:
-                e1, g1, h1 = self.energy(a + step * d, w_over_d0)
-                tiny = abs(e1 - e) <= 1e-13 * max(abs(e), 1e-30)
-                if e1 <= e + 1e-4 * step * float(g @ d) or (
-                        tiny and np.max(np.abs(g1)) < np.max(np.abs(g))):
-                    break
-                step *= 0.5
-            else:
-                break
-            a, e, g, hess = a + step * d, e1, g1, h1
-        raise FloatingPointError(f"section squeeze at w = {w_over_d0} D0 did not converge "
-                                 f"(largest generalised force {float(np.max(np.abs(g))):.2e} "
-                                 f"E D0 after Newton)")
+        a0 = np.zeros(len(self.modes)) if start is None else start
+        a, it = minimise(lambda a: self.energy(a, w_over_d0), a0,
+                         lambda h, g: shifted_cholesky_step(h, g, 1e-6), RESIDUAL_TOL,
+                         MAX_ITERATIONS, f"section squeeze at w = {w_over_d0} D0")
+        return self._measure(a, w_over_d0, it), a
 
     def _measure(self, a: NDArray, w: float, iterations: int) -> SqueezeState:
         pen, _, _ = self._gap(a, self.r0 - w)
