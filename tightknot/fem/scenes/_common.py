@@ -79,6 +79,21 @@ def convergence_table(run: Callable[[str], dict[str, Any]], keys: Sequence[str],
     return table, results
 
 
+def mesh_convergence(run: Callable[[str], dict[str, Any]], keys: Sequence[str],
+                     first: dict[str, Any], level: str, computed: bool) -> dict[str, Any]:
+    """A scene result's ``mesh_convergence`` entry: the table of :func:`convergence_table`
+    when ``computed``, else a note saying how to get it."""
+    if not computed:
+        return {"computed": False, "reason": "run with convergence=True for the table"}
+    return convergence_table(run, keys, first=first, level=level)[0]
+
+
+def check_dhat(dhat_over_d0: float) -> None:
+    """The barrier's activation distance over D0 must lie in [1e-6, 1e-2]."""
+    if not (isinstance(dhat_over_d0, (int, float)) and 1e-6 <= dhat_over_d0 <= 1e-2):
+        raise ValueError(f"dhat_over_d0 must lie in [1e-6, 1e-2], got {dhat_over_d0!r}")
+
+
 def finite(obj: Any) -> Any:
     """Convert NumPy scalars to Python and replace non-finite floats by None (JSON-safe)."""
     if isinstance(obj, dict):

@@ -42,10 +42,11 @@ from ..measure import section_area
 from ..mesh import extrude, lateral_faces, quarter_disk
 from ._common import (
     check_common,
+    check_dhat,
     check_positive,
-    convergence_table,
     finite,
     load_schedule,
+    mesh_convergence,
     relative,
 )
 from ._pair import GAP_OVER_DHAT, contact_edge, make_barrier, nodal_contact, stack
@@ -73,15 +74,12 @@ def run(mesh: str = "coarse", max_approach_over_d0: float = 0.3, steps: int = 4,
     if length_over_d0 < 2.0 * REFINED_LENGTH_OVER_D0 + 0.2:
         raise ValueError(f"length_over_d0 must be >= {2 * REFINED_LENGTH_OVER_D0 + 0.2} "
                          f"(the refined zone), got {length_over_d0}")
-    if not (isinstance(dhat_over_d0, (int, float)) and 1e-6 <= dhat_over_d0 <= 1e-2):
-        raise ValueError(f"dhat_over_d0 must lie in [1e-6, 1e-2], got {dhat_over_d0!r}")
+    check_dhat(dhat_over_d0)
     args = (max_approach_over_d0, steps, length_over_d0, diameter, youngs_modulus,
             dhat_over_d0)
     result = _run_one(mesh, *args)
-    result["mesh_convergence"] = (
-        convergence_table(lambda lvl: _run_one(lvl, *args), HEADLINE_KEYS, first=result,
-                          level=mesh)[0] if convergence else
-        {"computed": False, "reason": "run with convergence=True for the table"})
+    result["mesh_convergence"] = mesh_convergence(lambda lvl: _run_one(lvl, *args),
+                                                  HEADLINE_KEYS, result, mesh, convergence)
     if compare:
         from .indent import run as rigid_run
         from .soft_squeeze import compare_steps

@@ -34,10 +34,11 @@ from ..measure import section_area
 from ..mesh import lateral_faces, quarter_disk
 from ._common import (
     check_common,
+    check_dhat,
     check_positive,
-    convergence_table,
     finite,
     load_schedule,
+    mesh_convergence,
     relative,
 )
 from ._pair import GAP_OVER_DHAT, contact_edge, make_barrier, nodal_contact, stack
@@ -61,14 +62,11 @@ def run(mesh: str = "coarse", max_approach_over_d0: float = 0.3, steps: int = 4,
     check_common(mesh, max_approach_over_d0, steps)
     check_positive("diameter", diameter)
     check_positive("youngs_modulus", youngs_modulus)
-    if not (isinstance(dhat_over_d0, (int, float)) and 1e-6 <= dhat_over_d0 <= 1e-2):
-        raise ValueError(f"dhat_over_d0 must lie in [1e-6, 1e-2], got {dhat_over_d0!r}")
+    check_dhat(dhat_over_d0)
     args = (max_approach_over_d0, steps, diameter, youngs_modulus, dhat_over_d0)
     result = _run_one(mesh, *args)
-    result["mesh_convergence"] = (
-        convergence_table(lambda lvl: _run_one(lvl, *args), HEADLINE_KEYS, first=result,
-                          level=mesh)[0] if convergence else
-        {"computed": False, "reason": "run with convergence=True for the table"})
+    result["mesh_convergence"] = mesh_convergence(lambda lvl: _run_one(lvl, *args),
+                                                  HEADLINE_KEYS, result, mesh, convergence)
     if compare:
         from .squeeze import run as rigid_run
 

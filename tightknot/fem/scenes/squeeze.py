@@ -49,9 +49,9 @@ from ._common import (
     SMOOTHING_FACTOR,
     check_common,
     check_positive,
-    convergence_table,
     finite,
     load_schedule,
+    mesh_convergence,
     relative,
 )
 
@@ -103,13 +103,8 @@ def run(mesh: str = "coarse", max_approach_over_d0: float = 0.3, steps: int = 12
                   length_over_d0=length_over_d0, diameter=diameter,
                   youngs_modulus=youngs_modulus)
     result = _run_one(mesh, **kwargs)
-    if convergence:
-        table, _ = convergence_table(lambda lvl: _run_one(lvl, **kwargs), HEADLINE_KEYS,
-                                     first=result, level=mesh)
-        result["mesh_convergence"] = table
-    else:
-        result["mesh_convergence"] = {"computed": False,
-                                      "reason": "run with convergence=True for the table"}
+    result["mesh_convergence"] = mesh_convergence(lambda lvl: _run_one(lvl, **kwargs),
+                                                  HEADLINE_KEYS, result, mesh, convergence)
     return finite(result)
 
 

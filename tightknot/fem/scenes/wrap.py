@@ -74,9 +74,9 @@ from ..solver import Problem
 from ._common import (
     PENALTY_FACTOR,
     check_positive,
-    convergence_table,
     finite,
     load_schedule,
+    mesh_convergence,
     relative,
 )
 
@@ -200,13 +200,8 @@ def run(mesh: str = "coarse", max_tension_over_e_d0sq: float = 0.25,
                   wrap_angle_deg=wrap_angle_deg, length_over_d0=length_over_d0,
                   diameter=diameter, youngs_modulus=youngs_modulus)
     result = _run_one(mesh, **kwargs)
-    if convergence:
-        table, _ = convergence_table(lambda lvl: _run_one(lvl, **kwargs), HEADLINE_KEYS,
-                                     first=result, level=mesh)
-        result["mesh_convergence"] = table
-    else:
-        result["mesh_convergence"] = {"computed": False,
-                                      "reason": "run with convergence=True for the table"}
+    result["mesh_convergence"] = mesh_convergence(lambda lvl: _run_one(lvl, **kwargs),
+                                                  HEADLINE_KEYS, result, mesh, convergence)
     return finite(result)
 
 
