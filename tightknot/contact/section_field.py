@@ -197,19 +197,15 @@ class StraightSectionedRod:
         hl[:, 0, 0] = self.h * self.a0
         ql[:, 2:] = self.h * self.k * a
         hl[:, 2:, 2:] += self.h * np.diag(self.k)
-        c = 2.0 * self.weight  # both bodies
         soft = None
-        if self.body == "rod":
+        if self.body == "rod":  # couples sections along the patch: assembled globally below
             soft = self._soft_contact(lam, zc, a, w)
             e += soft[0]
-            ct = None
         else:
+            c = 2.0 * self.weight  # both bodies
             ct = self._contact(lam, zc, a, w)
             phi, dphi, d2phi = self._penalty(ct["pen"])
             e += c * float(np.sum(phi))
-        if ct is None:
-            pass
-        else:
             self._rigid_local(ct, dphi, d2phi, c, ql, hl)
         tr = self.transform
         gl = ql @ tr  # per edge, in (Z_i, Z_i+1, a_i)
