@@ -32,10 +32,10 @@ import numpy as np
 from tightknot.knots.tangle_scenes import ROD_NAMES, TangleScene
 from tightknot.knots.topology import TopologyError
 from tightknot.loading.options import LoadPath
+from tightknot.loading.tie import load_step_options
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.state import State
 from tightknot.solvers.continuation import (
-    ContinuationOptions,
     StaticResult,
     StepRecord,
     continuation,
@@ -138,14 +138,6 @@ def _grips(scene: TangleScene, positions: np.ndarray, shift: float = 0.0,
     return bcs
 
 
-def _opts(steps: int, tol: float) -> ContinuationOptions:
-    # Proximal steps carry the solve through a loop that snaps as the tangle tightens (a
-    # limit point of the displacement path), as for the study's knots.
-    return ContinuationOptions(steps=steps, max_step=1.0 / steps, min_step=1e-4,
-                               newton=NewtonOptions(residual_tol=tol, max_iterations=60),
-                               proximal_dt=1e-3, proximal_steps=200)
-
-
 def pull_tangle(
     scene: TangleScene,
     end_distance: float | None = None,
@@ -244,7 +236,7 @@ def pull_tangle(
             return _REACHED
         return None
 
-    cont = continuation(system, _opts(pull_steps, residual_tol), pull_step).run()
+    cont = continuation(system, load_step_options(pull_steps, residual_tol), pull_step).run()
     res.phases["pull"] = cont
     res.newton_iterations += cont.newton_iterations
     reached = _REACHED in cont.failure
@@ -271,7 +263,7 @@ def pull_tangle(
     system = RodSystem(scene.model, system.state, bcs)
     system.add_term(scene.contact)
     system.set_load(0.0)
-    cont = continuation(system, _opts(force_steps, residual_tol),
+    cont = continuation(system, load_step_options(force_steps, residual_tol),
                         lambda s, r: record("force", s, r)).run()
     res.phases["force"] = cont
     res.newton_iterations += cont.newton_iterations

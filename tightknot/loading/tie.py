@@ -115,7 +115,9 @@ def _attached(system: RodSystem, attach: Callable[[RodSystem], None] | None) -> 
     return system
 
 
-def _opts(steps: int, tol: float) -> ContinuationOptions:
+def load_step_options(steps: int, tol: float) -> ContinuationOptions:
+    """The continuation of a knot's or a tangle's load path: ``steps`` initial load steps,
+    Newton to ``tol``."""
     # Knots have limit points along their paths (a loop that flips, a tail that slides
     # through): proximal steps carry the solve through them (proximal_dt).
     return ContinuationOptions(steps=steps, max_step=1.0 / steps, min_step=1e-4,
@@ -236,7 +238,7 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
         sys_.state.x = sys_.state.x * c
         sys_.set_load(t1)
 
-    res = yield from continuation(p, _opts(tighten_steps, residual_tol),
+    res = yield from continuation(p, load_step_options(tighten_steps, residual_tol),
                                   _checker(scene, "tighten", types, hook, knot_type), similar)
     phases["tighten"] = res
     iters += res.newton_iterations
@@ -274,7 +276,7 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
     system = RodSystem(model, state, bcs)
     system.add_term(scene.contact)
     p = _attached(system, attach)
-    res = yield from continuation(p, _opts(pull_steps, residual_tol),
+    res = yield from continuation(p, load_step_options(pull_steps, residual_tol),
                                   _checker(scene, "pull", types, hook, knot_type))
     phases["pull"] = res
     iters += res.newton_iterations
