@@ -87,7 +87,7 @@ def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
     the tightening's end reaction and the pull's force are separate series."""
     x = system.state.x
     r_e, r_v = vertex_radii(scene, x, system.rest)
-    rep = contact_report(scene.contact, x)
+    rep = contact_report(scene.contact, x, system.rest, system.state)
     values, at = rod_field(color_by, scene, x, system.rest, rep)
     log.log_rod(f"{name}/rod", x, scene.closed, r_e, values, color_by, field_at=at,
                 radii_at="edge")
@@ -313,7 +313,7 @@ def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
     # centerline (segments touch between vertices) and the contact law's onset band.
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
                              radii=r_v, contact_tol=CONTACT_TOL)
-    contact = contact_report(scene.contact, x, res.system.rest)
+    contact = contact_report(scene.contact, x, res.system.rest, res.system.state)
     summary = summarise(scene, res, rep, contact)
     summary["load_steps"] = load_steps
     # What the mesh costs in accuracy, so a coarse run says so (the trade-off study's numbers);
