@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import warp as wp
 
@@ -26,7 +27,7 @@ from tightknot.rods.proximity import ProximityCheck
 from tightknot.rods.staging import Output
 from tightknot.rods.state import State
 from tightknot.rods.term import EnergyTerm
-from tightknot.solvers.linear import SparseDirect
+from tightknot.solvers.linear import LowRankHessian, SparseDirect
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
 
@@ -235,12 +236,16 @@ class RodSystem:
                         break
                 else:
                     break
+        low_rank = []
         for term in self.extra_terms:
             if id(term) in results:
                 # (energy, gradient) or, from a contact layer with a radius window, also the
-                # COO Hessian terms outside its pair blocks
+                # COO Hessian terms outside its pair blocks; with a rod-mean radius also a
+                # dense update (U, C) of low rank (tightknot.contact.rod_mean_radius)
                 e_k, g_k, *rest_k = results[id(term)]
                 h_k = rest_k[0] if rest_k else None
+                if len(rest_k) > 1 and rest_k[1] is not None:
+                    low_rank.append(rest_k[1])
             else:
                 e_k, g_k, h_k = term.evaluate(x, self.rest, want_grad or want_hess, want_hess)
             split.extra[term.name] = e_k
@@ -264,6 +269,10 @@ class RodSystem:
             hmat = pattern.matrix(data)
             if coo_parts:
                 hmat = hmat + self._coo_free(coo_parts)
+            if low_rank:
+                free = self.pattern.free_dofs
+                hmat = LowRankHessian(hmat, np.hstack([u[free] for u, _ in low_rank]),
+                                      sla.block_diag(*[c for _, c in low_rank]))
         return split.total, g_free, hmat
 
     def evaluated(self, u: np.ndarray, x: np.ndarray, theta: np.ndarray, answer: Any,
@@ -286,6 +295,8 @@ class RodSystem:
                 data = h.data.copy()
                 self._add_inertia_diagonal(data, h.diag_slot)
                 h = type(h)(h.indptr, h.indices, h.diag_slot, data)
+            if answer.low_rank is not None:
+                h = LowRankHessian(h, *answer.low_rank)
         return split.total, g_free, h
 
     def _with_inertia(self, u: np.ndarray, split: EnergySplit,
