@@ -26,9 +26,14 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   law (:class:`~tightknot.contact.law.RadialComplianceLaw`, or the ``law`` given):
   sections flatten and thin with stretch. Neglects friction, the coupling between the
   squeezes of neighbouring contacts on one section (each pair follows the single-pair
-  fit) and any deformation beyond the calibrated range (overlap 0.3 D); and the section
-  thins with its edge's own stretch, so a crossing pulls the edges under it apart (the FEM
-  cross-check's indent force is 11 to 16 % short, docs/fem_crosscheck.md).
+  fit) and any deformation beyond the calibrated range (overlap 0.3 D). Every section of
+  a rod thins with the rod's mean stretch L/L0 (:mod:`tightknot.contact.rod_mean_radius`;
+  with its edge's own stretch a crossing pulled the edges under it apart, 3.4 times the
+  FEM's axial force, and a knot pulled hard collapsed: docs/design_notes.md, contact);
+  neglects where along the rod a squeezed section extends: the contact's pull toward
+  thinner sections acts on the whole rod, so the tails' stretch exceeds the pull's (their
+  elastic tension 12 to 15 % above it on the 185 mm knot at 2 to 20 N), while the knot's
+  shape sees the pull itself.
   ``contact="smoothed"``: the compliant law with the section thinned by the stretch
   averaged over +-:data:`SMOOTHED_RADIUS_WINDOW` D0 along the rod
   (:mod:`tightknot.contact.section_radius`): the indent force within -8 to +7 % of the
@@ -271,7 +276,7 @@ def contact_layer(model: Model, contact: str | SectionSettings = "compliant",
         return ContactLayer(model, base if base.rigid else base.rigid_tube())
     if contact == "smoothed":
         return ContactLayer(model, law, radius_window=SMOOTHED_RADIUS_WINDOW)
-    return ContactLayer(model, law)
+    return ContactLayer(model, law, thinning="rod")
 
 
 def _closed_knot(name: str, knot_type: str, curve: np.ndarray, ratio: float, d0: float,
@@ -699,11 +704,12 @@ def bending_force_scale(scene: KnotScene) -> float:
 
 def vertex_radii(scene: KnotScene, x: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, ...]:
     """Deformed edge radii r0 lam^-nu [m] (the rest radius for a rigid tube; lam the stretch
-    that thins the section: the edge's own, or the "smoothed" level's window mean) and
+    that thins the section: the rod's mean, the edge's own, or a window mean) and
     their vertex averages [m], for centerline ``x`` and edge rest lengths ``rest``."""
     m = scene.model
     ev = m.edge_vertex
-    if scene.contact is not None and scene.contact.radius_window > 0.0:
+    if scene.contact is not None and (scene.contact.radius_window > 0.0
+                                      or scene.contact.thinning == "rod"):
         lam = scene.contact.section_stretch(x, rest)
     else:
         lam = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1) / rest

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import warp as wp
 
@@ -26,7 +27,7 @@ from tightknot.rods.proximity import ProximityCheck
 from tightknot.rods.staging import Output
 from tightknot.rods.state import State
 from tightknot.rods.term import BlockHessian, EnergyTerm
-from tightknot.solvers.linear import SparseDirect
+from tightknot.solvers.linear import LowRankHessian, SparseDirect
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
 
@@ -258,6 +259,7 @@ class RodSystem:
                         break
                 else:
                     break
+        low_rank = []
         for term in self.extra_terms:
             if term is self.dof_term:
                 e_k, g_k, g_own, h_own = term.evaluate_with_dofs(
@@ -270,9 +272,12 @@ class RodSystem:
                 continue
             if id(term) in results:
                 # (energy, gradient) or, from a contact layer with a radius window, also the
-                # COO Hessian terms outside its pair blocks
+                # COO Hessian terms outside its pair blocks; with a rod-mean radius also a
+                # dense update (U, C) of low rank (tightknot.contact.rod_mean_radius)
                 e_k, g_k, *rest_k = results[id(term)]
                 h_k = rest_k[0] if rest_k else None
+                if len(rest_k) > 1 and rest_k[1] is not None:
+                    low_rank.append(rest_k[1])
             else:
                 e_k, g_k, h_k = term.evaluate(x, self.rest, want_grad or want_hess, want_hess)
             split.extra[term.name] = e_k
@@ -300,6 +305,10 @@ class RodSystem:
                 hmat = hmat + self._coo_free(coo_parts)
             if own is not None:
                 hmat = self._with_own_hessian(hmat, own[1])
+            if low_rank:
+                free = self.pattern.free_dofs
+                hmat = LowRankHessian(hmat, np.hstack([u[free] for u, _ in low_rank]),
+                                      sla.block_diag(*[c for _, c in low_rank]))
         return split.total, g_free, hmat
 
     def term_gradient(self, term: EnergyTerm) -> np.ndarray:
@@ -331,6 +340,8 @@ class RodSystem:
                 data = h.data.copy()
                 self._add_inertia_diagonal(data, h.diag_slot)
                 h = type(h)(h.indptr, h.indices, h.diag_slot, data)
+            if answer.low_rank is not None:
+                h = LowRankHessian(h, *answer.low_rank)
         return split.total, g_free, h
 
     def _with_inertia(self, u: np.ndarray, split: EnergySplit,
