@@ -123,7 +123,8 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
             arr(np.arange(16), wp.int32)]
     bsz = 3 + K
     outs = [wp.zeros(2, dtype=f), wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),
-            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f)]
+            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(2 * nl * nl, dtype=f),
+            wp.zeros(1, dtype=f), wp.zeros(1, dtype=f)]
     wp.launch(sk.DERIVATIVES, 2, model + data, outs)
     g = outs[2].numpy().reshape(2, nl)
     grad = g[0].copy()
@@ -266,3 +267,56 @@ def test_too_many_modes_for_the_kernels_are_refused() -> None:
     system, _ = _straight_rod(n=4)
     with pytest.raises(ValueError, match="section_modes must be <= 12"):
         SectionedLayer(system.model, SectionSettings(max_mode=13, samples=64))
+
+
+def _boundary(layer: SectionedLayer, state: State, v: int, phis: np.ndarray) -> np.ndarray:
+    """World points [m] of vertex v's section boundary at angles ``phis`` of its frame,
+    relative to the vertex (the storage edge's reference frame)."""
+    from tightknot.contact.sectioned_reference import mode_basis
+
+    e = min(v, layer.model.edge_count - 1)
+    t, d1 = state.t_ref[e], state.d1_ref[e]
+    d2 = np.cross(t, d1)
+    c = state.extra[layer.vertex_offset[v]:layer.vertex_offset[v] + K]
+    r = 0.5 * 0.0085 + mode_basis(MODES, phis)[0] @ c
+    return r[:, None] * (np.cos(phis)[:, None] * d1 + np.sin(phis)[:, None] * d2)
+
+
+def test_sections_slide_and_turn_with_the_material() -> None:
+    # A rod on a helix-free bent line: slide the material by 2 edges and turn it about x;
+    # each vertex's boundary must arrive turned, two vertices on, whatever the new frames.
+    d0 = 0.0085
+    n = 12
+    s = np.linspace(0.0, 3.0 * d0, n + 1)
+    pts = np.c_[s, 0.2 * d0 * np.sin(s / d0), 0.1 * d0 * np.cos(s / d0)]
+    b = RodBuilder(twist=False)
+    b.add_rod(pts, d0, Material(1.25e6, 0.5, 1160.0))
+    model = b.finalize()
+    old = State.initial(model)
+    layer = SectionedLayer(model, SectionSettings(max_mode=8))
+    old.extra = 1e-4 * np.random.default_rng(4).normal(size=layer.dof_count)
+    k, ang = 2, 0.7
+    rot = np.array([[1.0, 0.0, 0.0], [0.0, math.cos(ang), -math.sin(ang)],
+                    [0.0, math.sin(ang), math.cos(ang)]])
+    moved = np.empty_like(old.x)
+    moved[k:] = old.x[:-k]
+    moved[:k] = old.x[0] + (old.x[0] - old.x[1]) * np.arange(k, 0, -1)[:, None]
+    new = State.initial(model, positions=moved @ rot.T)
+    new.extra = layer.slid_sections(old.extra, (old.t_ref, old.d1_ref),
+                                    (new.t_ref, new.d1_ref), k, rot)
+    phis = np.linspace(0.0, 2.0 * math.pi, 9)[:-1]
+    for v in range(n - 2):  # the last vertices change their storage edge's tangent
+        a = _boundary(layer, old, v, phis) @ rot.T
+        # the same radius in every direction, each state read in its own frame
+        rb = np.array([np.linalg.norm(_boundary_at(layer, new, v + k, p)) for p in a])
+        assert np.allclose(np.linalg.norm(a, axis=1), rb, rtol=1e-9), v
+    assert np.all(new.extra.reshape(-1, K)[:k] == 0.0)  # no source: round
+
+
+def _boundary_at(layer: SectionedLayer, state: State, v: int, point: np.ndarray) -> np.ndarray:
+    """The boundary point of vertex v's section in the direction of ``point`` (relative)."""
+    e = min(v, layer.model.edge_count - 1)
+    t, d1 = state.t_ref[e], state.d1_ref[e]
+    d2 = np.cross(t, d1)
+    phi = math.atan2(point @ d2, point @ d1)
+    return _boundary(layer, state, v, np.array([phi]))[0]

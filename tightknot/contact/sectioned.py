@@ -69,11 +69,17 @@ class SectionCalibration:
         penalty_by_max_mode: the contact penalty over E/D0 for each mode count N, fitted to
             the FEM's plane-strain squeeze (:func:`tightknot.fem.section_calibration.
             calibrate_section_penalty`): the local compliance of the modes above N.
+        calibrated_w_hat: the largest per-side approach w/D0 of the squeeze levels the
+            penalty was fitted to (line contact).
+        crossing_w_hat: the largest per-side approach w/D0 at which the FEM judged a
+            crossing (the indent of the cross-check).
         source: where the numbers come from.
     """
 
     decay_length_over_d0: dict[int, float]
     penalty_by_max_mode: dict[int, float]
+    calibrated_w_hat: float
+    crossing_w_hat: float
     source: str
 
     @classmethod
@@ -92,7 +98,9 @@ class SectionCalibration:
             raise ValueError(f"{where}: the decay lengths of modes 2, 3 and 4 are required")
         pen = {int(k): float(v["penalty"]) for k, v in d["penalty_by_max_mode"].items()}
         date = d.get("provenance", {}).get("date", "?")
-        return cls(decay, pen, f"FEM calibration {where.name} ({date})")
+        fitted = float(d.get("fem", {}).get("fitted_w_over_d0", [0.0, 0.0])[1])
+        return cls(decay, pen, fitted, float(d.get("validated_crossing_w_over_d0", 0.0)),
+                   f"FEM calibration {where.name} ({date})")
 
     def decay_length(self, n: int) -> tuple[float, bool]:
         """l_n / D0 of mode ``n`` and whether it was measured (else extrapolated)."""
@@ -408,12 +416,13 @@ class SectionedLayer(ContactLayer):
         blocks = wp.zeros(block_count * b * b if derivatives else 1, dtype=f64, device=dev)
         w_slots = wp.array(slots.astype(np.int32).ravel() if derivatives else np.zeros(1, np.int32),
                            dtype=wp.int32, device=dev)
+        local = wp.zeros(threads * nl * nl if derivatives else 1, dtype=f64, device=dev)
         ns = threads * ng * self.section.samples if report else 1
         s_pen = wp.zeros(ns, dtype=f64, device=dev)
         s_wt = wp.zeros(ns, dtype=f64, device=dev)
         wp.launch(kernel, threads, [*self._model_args, wx, *data,
                                     self.broad_phase.buffer_of(pairs), w_slots],
-                  [energy, pen_max, grad, blocks, s_pen, s_wt], device=dev)
+                  [energy, pen_max, grad, blocks, local, s_pen, s_wt], device=dev)
         out = {"energy": energy.numpy(), "pen_max": pen_max.numpy()}
         if derivatives:
             out["grad"] = grad.numpy().reshape(threads, nl)

@@ -468,6 +468,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         pen_max_out: wp.array(dtype=wp.float64),
         grad_out: wp.array(dtype=wp.float64),
         blocks_out: wp.array(dtype=wp.float64),
+        local_out: wp.array(dtype=wp.float64),
         sample_pen_out: wp.array(dtype=wp.float64),
         sample_weight_out: wp.array(dtype=wp.float64),
     ):
@@ -554,6 +555,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         mta = end_twist_in[ea]
         mtb = end_twist_in[eb]
         go = tid * nl
+        touched = int(0)
         for gi in range(ng):
             u = gauss_xi[gi]
             xu = xa0 + u * vec_a
@@ -696,8 +698,12 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     h -= (ph[1] * wt1) * (wp.outer(r_g, r_v) + wp.outer(r_v, r_g))
                     h += ph[0] * (wt2 * wp.outer(r_v, r_v) + wt1 * hvr)
                     h = a_s * h
-                    expand(h, r_grad, u, v, ba, bb, bpsi1, mta, mtb, k, go, tid, rig_a,
-                           rig_b, grad_out, slots_in, blocks_out)
+                    expand(h, r_grad, u, v, ba, bb, bpsi1, mta, mtb, k, go, tid * nl * nl,
+                           nl, rig_a, rig_b, grad_out, local_out)
+                    touched = 1
+        if wp.static(derivatives):
+            if touched != 0:
+                scatter_blocks(local_out, tid * nl * nl, nl, k, tid, slots_in, blocks_out)
         energy_out[tid] = energy
         pen_max_out[tid] = pen_max
 
@@ -706,121 +712,143 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
 
 
 @wp.func
-def node_row(h: mat16d, n: int, l: int, j: int, wa: vecKd, wb: vecKd, wg: vecKd,
-             wd: vecKd) -> vec16d:
-    """Row e^T h of the reduced Hessian for local dof ``l`` of node ``n`` (0, 1: A's
-    vertices, 2, 3: B's): a coordinate (l < 3) is reduced direction 3 n + l; a section
-    coefficient j = l - 3 is A's direction 12 times ``wa[j]``, or B's 13, 14, 15 times
-    ``wb[j]``, ``wg[j]``, ``wd[j]``."""
-    out = vec16d()
-    if l < 3:
-        for c in range(16):
-            out[c] = h[3 * n + l, c]
-    elif n < 2:
-        for c in range(16):
-            out[c] = wa[j] * h[12, c]
-    else:
-        for c in range(16):
-            out[c] = wb[j] * h[13, c] + wg[j] * h[14, c] + wd[j] * h[15, c]
-    return out
-
-
-@wp.func
-def node_dot(r: vec16d, n: int, l: int, j: int, wa: vecKd, wb: vecKd, wg: vecKd,
-             wd: vecKd) -> wp.float64:
-    """r . e for local dof ``l`` of node ``n`` (node_row's directions)."""
-    if l < 3:
-        return r[3 * n + l]
-    if n < 2:
-        return r[12] * wa[j]
-    return r[13] * wb[j] + r[14] * wg[j] + r[15] * wd[j]
+def add_sym(buf: wp.array(dtype=wp.float64), base: int, nl: int, i: int, j: int,
+            val: wp.float64):
+    """Add ``val`` at (i, j) and (j, i) of the pass's local Hessian (once on the diagonal)."""
+    buf[base + i * nl + j] = buf[base + i * nl + j] + val
+    if i != j:
+        buf[base + j * nl + i] = buf[base + j * nl + i] + val
 
 
 @wp.func
 def expand(h: mat16d, r_grad: vec16d, u: wp.float64, v: wp.float64, ba: vecKd, bb: vecKd,
-           bs: vecKd, mta: wp.float64, mtb: wp.float64, k: int, go: int, tid: int,
+           bs: vecKd, mta: wp.float64, mtb: wp.float64, k: int, go: int, base: int, nl: int,
            rig_a: int, rig_b: int, grad_out: wp.array(dtype=wp.float64),
-           slots: wp.array(dtype=wp.int32), blocks: wp.array(dtype=wp.float64)):
-    """Add a sample's reduced gradient and Hessian to the pass's gradient and to its
-    node-pair blocks (nodes A0, A1, B0, B1; each with 3 coordinates and k coefficients).
-    The section directions are carried to the vertices: alpha (``ba``) by (1 - u) and u Q
-    to A's, beta (``bb``) and gamma (``bs``) by (1 - v) and v Q to B's, delta (``bb``) by
-    -1 and Q to B's. Pair p's blocks are ``slots[16 p + 4 n_i + n_j]`` with its nodes in
-    (a0, a1, b0, b1) order (pass 1 has A = b: its node n is the pair's (n + 2) % 4)."""
-    bsz = 3 + k
+           local: wp.array(dtype=wp.float64)):
+    """Add a sample's reduced gradient and Hessian to the pass's local ones (over x_A0,
+    x_A1, x_B0, x_B1, then the sections of A0, A1, B0, B1: k each). The section directions
+    are carried to the vertices: alpha (``ba``) by (1 - u) and u Q to A's, beta (``bb``)
+    and gamma (``bs``) by (1 - v) and v Q to B's, delta (``bb``) by -1 and Q to B's; each
+    block is formed in that low-rank form (a rank-1 block for A's sections, rank 3 for
+    B's), not by the dense expansion."""
     qa = rotate_modes(ba, mta, k, 0)
     qb = rotate_modes(bb, mtb, k, 0)
     qs = rotate_modes(bs, mtb, k, 0)
-    zero = vecKd()
+    one_u = f64(1.0) - u
+    one_v = f64(1.0) - v
+    a0 = 12
+    a1 = 12 + k
+    b0 = 12 + 2 * k
+    b1 = 12 + 3 * k
     for i in range(12):
         grad_out[go + i] = grad_out[go + i] + r_grad[i]
+        for j in range(i, 12):
+            add_sym(local, base, nl, i, j, h[i, j])
     for j in range(k):
         if rig_a == 0:
-            grad_out[go + 12 + j] = grad_out[go + 12 + j] + r_grad[12] * (f64(1.0) - u) * ba[j]
-            grad_out[go + 12 + k + j] = grad_out[go + 12 + k + j] + r_grad[12] * u * qa[j]
+            grad_out[go + a0 + j] = grad_out[go + a0 + j] + r_grad[12] * one_u * ba[j]
+            grad_out[go + a1 + j] = grad_out[go + a1 + j] + r_grad[12] * u * qa[j]
         if rig_b == 0:
-            grad_out[go + 12 + 2 * k + j] = (grad_out[go + 12 + 2 * k + j]
-                                             + r_grad[13] * (f64(1.0) - v) * bb[j])
-            grad_out[go + 12 + 3 * k + j] = grad_out[go + 12 + 3 * k + j] + r_grad[13] * v * qb[j]
+            grad_out[go + b0 + j] = grad_out[go + b0 + j] + r_grad[13] * one_v * bb[j]
+            grad_out[go + b1 + j] = grad_out[go + b1 + j] + r_grad[13] * v * qb[j]
+    # B's section weights on (beta, gamma, delta) at its two vertices
+    for i in range(12):
+        if rig_a == 0:
+            c = h[i, 12]
+            for j in range(k):
+                add_sym(local, base, nl, i, a0 + j, c * one_u * ba[j])
+                add_sym(local, base, nl, i, a1 + j, c * u * qa[j])
+        if rig_b == 0:
+            cb = h[i, 13]
+            cg = h[i, 14]
+            cd = h[i, 15]
+            for j in range(k):
+                add_sym(local, base, nl, i, b0 + j,
+                        one_v * (cb * bb[j] + cg * bs[j]) - cd * bb[j])
+                add_sym(local, base, nl, i, b1 + j, v * (cb * qb[j] + cg * qs[j]) + cd * qb[j])
+    if rig_a == 0:
+        caa = h[12, 12]
+        for i in range(k):
+            wi0 = one_u * ba[i]
+            wi1 = u * qa[i]
+            for j in range(k):
+                w0 = one_u * ba[j]
+                w1 = u * qa[j]
+                if j >= i:
+                    add_sym(local, base, nl, a0 + i, a0 + j, caa * wi0 * w0)
+                    add_sym(local, base, nl, a1 + i, a1 + j, caa * wi1 * w1)
+                add_sym(local, base, nl, a0 + i, a1 + j, caa * wi0 * w1)
+            if rig_b == 0:
+                # A's alpha row against B's (beta, gamma, delta)
+                rb = h[12, 13]
+                rg = h[12, 14]
+                rd = h[12, 15]
+                for j in range(k):
+                    t0 = one_v * (rb * bb[j] + rg * bs[j]) - rd * bb[j]
+                    t1 = v * (rb * qb[j] + rg * qs[j]) + rd * qb[j]
+                    add_sym(local, base, nl, a0 + i, b0 + j, wi0 * t0)
+                    add_sym(local, base, nl, a0 + i, b1 + j, wi0 * t1)
+                    add_sym(local, base, nl, a1 + i, b0 + j, wi1 * t0)
+                    add_sym(local, base, nl, a1 + i, b1 + j, wi1 * t1)
+    if rig_b == 0:
+        for i in range(k):
+            # rows of B0 and B1 coefficient i in (beta, gamma, delta), times h_BB
+            x0 = one_v * bb[i]
+            y0 = one_v * bs[i]
+            z0 = -bb[i]
+            x1 = v * qb[i]
+            y1 = v * qs[i]
+            z1 = qb[i]
+            p0 = h[13, 13] * x0 + h[14, 13] * y0 + h[15, 13] * z0
+            q0 = h[13, 14] * x0 + h[14, 14] * y0 + h[15, 14] * z0
+            s0 = h[13, 15] * x0 + h[14, 15] * y0 + h[15, 15] * z0
+            p1 = h[13, 13] * x1 + h[14, 13] * y1 + h[15, 13] * z1
+            q1 = h[13, 14] * x1 + h[14, 14] * y1 + h[15, 14] * z1
+            s1 = h[13, 15] * x1 + h[14, 15] * y1 + h[15, 15] * z1
+            for j in range(k):
+                c0x = one_v * bb[j]
+                c0y = one_v * bs[j]
+                c0z = -bb[j]
+                c1x = v * qb[j]
+                c1y = v * qs[j]
+                c1z = qb[j]
+                if j >= i:
+                    add_sym(local, base, nl, b0 + i, b0 + j, p0 * c0x + q0 * c0y + s0 * c0z)
+                    add_sym(local, base, nl, b1 + i, b1 + j, p1 * c1x + q1 * c1y + s1 * c1z)
+                add_sym(local, base, nl, b0 + i, b1 + j, p0 * c1x + q0 * c1y + s0 * c1z)
+
+
+@wp.func
+def scatter_blocks(local: wp.array(dtype=wp.float64), base: int, nl: int, k: int, tid: int,
+                   slots: wp.array(dtype=wp.int32), blocks: wp.array(dtype=wp.float64)):
+    """Add the pass's local Hessian into its node-pair blocks: local dof i belongs to node
+    i // 3 (coordinates) or (i - 12) // k (sections) of (A0, A1, B0, B1), at index i % 3 or
+    3 + (i - 12) % k of the node's 3 + k dofs; pair p's 16 blocks are
+    ``slots[16 p + 4 n_i + n_j]`` with its nodes in (a0, a1, b0, b1) order (pass 1 has A =
+    b: its node n is the pair's (n + 2) % 4)."""
+    bsz = 3 + k
     pair = tid // 2
-    for n in range(4):
-        rig_n = rig_a
-        if n >= 2:
-            rig_n = rig_b
-        # the node's section weights on the reduced directions
-        wa = zero
-        wb = zero
-        wg = zero
-        wd = zero
-        if n == 0:
-            wa = (f64(1.0) - u) * ba
-        elif n == 1:
-            wa = u * qa
-        elif n == 2:
-            wb = (f64(1.0) - v) * bb
-            wg = (f64(1.0) - v) * bs
-            wd = -bb
-        else:
-            wb = v * qb
-            wg = v * qs
-            wd = qb
-        rows = 3
-        if rig_n == 0:
-            rows = bsz
-        for l in range(rows):
-            r = node_row(h, n, l, l - 3, wa, wb, wg, wd)
-            for m in range(4):
-                rig_m = rig_a
-                if m >= 2:
-                    rig_m = rig_b
-                ma = zero
-                mb = zero
-                mg = zero
-                md = zero
-                if m == 0:
-                    ma = (f64(1.0) - u) * ba
-                elif m == 1:
-                    ma = u * qa
-                elif m == 2:
-                    mb = (f64(1.0) - v) * bb
-                    mg = (f64(1.0) - v) * bs
-                    md = -bb
-                else:
-                    mb = v * qb
-                    mg = v * qs
-                    md = qb
-                ni = n
-                nj = m
-                if tid % 2 == 1:
-                    ni = (n + 2) % 4
-                    nj = (m + 2) % 4
-                base = (slots[pair * 16 + ni * 4 + nj] * bsz + l) * bsz
-                cols = 3
-                if rig_m == 0:
-                    cols = bsz
-                for l2 in range(cols):
-                    val = node_dot(r, m, l2, l2 - 3, ma, mb, mg, md)
-                    wp.atomic_add(blocks, base + l2, val)
+    for i in range(nl):
+        ni = i // 3
+        li = i % 3
+        if i >= 12:
+            ni = (i - 12) // k
+            li = 3 + (i - 12) % k
+        if tid % 2 == 1:
+            ni = (ni + 2) % 4
+        for j in range(nl):
+            val = local[base + i * nl + j]
+            if val == f64(0.0):
+                continue
+            nj = j // 3
+            lj = j % 3
+            if j >= 12:
+                nj = (j - 12) // k
+                lj = 3 + (j - 12) % k
+            if tid % 2 == 1:
+                nj = (nj + 2) % 4
+            slot = slots[pair * 16 + ni * 4 + nj]
+            wp.atomic_add(blocks, (slot * bsz + li) * bsz + lj, val)
 
 
 #: The variants: energy only, energy with derivatives, energy with the samples' report.
