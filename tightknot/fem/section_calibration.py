@@ -73,6 +73,8 @@ def calibrate_section_penalty(modes: range | list[int] = range(4, 13), mesh: str
                 "check_force_per_length_over_e_d0": check.tolist(),
                 "fitted_levels": int(keep.sum()),
                 "fitted_w_over_d0": [float(w_fit[0]), float(w_fit[-1])]},
+        # The deepest indent level of the FEM cross-check (crosscheck --contact sectioned).
+        "validated_crossing_w_over_d0": 0.1215,
         "provenance": {"date": datetime.date.today().isoformat(),
                        "function": "tightknot.fem.section_calibration."
                                    "calibrate_section_penalty",

@@ -16,6 +16,7 @@ import numpy as np
 
 from tightknot.contact.checks import deepest_approaches
 from tightknot.contact.report import ContactReport, contact_report
+from tightknot.contact.sectioned import SectionedLayer
 from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal_overlay import aligned, ideal_report
 from tightknot.knots.measure import analyze_centerline
@@ -242,23 +243,30 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
     w_cross = None
     if not law.rigid and x is not None and rest is not None:
         w_cross = deepest_approaches(scene.contact, x, rest)[1] / scene.diameter
+    # The sectioned level's range is its own calibration's (the squeeze fit, the crossing
+    # the FEM judged), the other levels' their law's.
+    sectioned = isinstance(scene.contact, SectionedLayer)
+    limit = scene.contact.calibration.calibrated_w_hat if sectioned else law.calibrated_w_hat
+    cross_limit = scene.contact.calibration.crossing_w_hat if sectioned else law.power_w_hat
+    what = "the sections were calibrated to" if sectioned else "the law was calibrated to"
     if not law.rigid:
-        if w_hat > law.calibrated_w_hat:
+        if w_hat > limit:
             warnings.append(f"the contact reaches a per-side approach w/D0 = {w_hat:.3g}, "
-                            f"beyond the {law.calibrated_w_hat:.3g} the law was calibrated to "
-                            "(its force there is extrapolated)")
-        if w_cross is not None and w_cross > law.power_w_hat:
+                            f"beyond the {limit:.3g} {what} (its force there is "
+                            "extrapolated)")
+        if w_cross is not None and w_cross > cross_limit:
+            judged = ("the FEM judged a crossing at" if sectioned
+                      else "the point law was fitted to")
             warnings.append(f"a crossing reaches w/D0 = {w_cross:.3g}, beyond the "
-                            f"{law.power_w_hat:.3g} the point law was fitted to (its force "
-                            "there is extrapolated)")
+                            f"{cross_limit:.3g} {judged} (its force there is extrapolated)")
         nus = {r.material.poisson_ratio for r in scene.model.rods}
         if any(abs(nu - 0.5) > 1e-12 for nu in nus):
             warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "
                             "calibrated on an incompressible solid (nu = 0.5): extrapolated")
     return {"max_approach_w_over_D0": w_hat,
-            "calibrated_w_over_D0": None if law.rigid else law.calibrated_w_hat,
+            "calibrated_w_over_D0": None if law.rigid else limit,
             "max_crossing_w_over_D0": w_cross,
-            "crossing_calibrated_w_over_D0": None if law.rigid else law.power_w_hat,
+            "crossing_calibrated_w_over_D0": None if law.rigid else cross_limit,
             "outside_calibrated_range": bool(warnings), "warnings": warnings}
 
 
