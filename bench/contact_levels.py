@@ -1,6 +1,6 @@
-"""The study's three knots at the contact levels ``compliant`` and ``smoothed``: Newton
-iterations, wall time and the knots' measures, in one run (compare ratios, not seconds:
-the machines are shared).
+"""The study's three knots at the contact levels ``compliant``, ``smoothed`` and
+``sectioned``: Newton iterations, wall time and the knots' measures, in one run (compare
+ratios, not seconds: the machines are shared).
 
 Usage: ``python bench/contact_levels.py [--closed-nodes 100] [--open-nodes 150]
 [--levels compliant smoothed] [--json out.json]``.
@@ -57,7 +57,7 @@ def main() -> None:
     parser.add_argument("--closed-nodes", type=int, default=100)
     parser.add_argument("--open-nodes", type=int, default=150)
     parser.add_argument("--levels", nargs="+", default=["compliant", "smoothed"],
-                        choices=["compliant", "smoothed", "rigid"])
+                        choices=["compliant", "smoothed", "sectioned", "rigid"])
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     tie(closed_trefoil(nodes=40), tighten_steps=5).run()  # compile the kernels outside the timing

@@ -203,3 +203,24 @@ def test_level_truth_reads_each_level_off_the_report(report):
     assert "| compliant |" in format_table(table)
     with pytest.raises(ValueError, match="cross-check report"):
         level_truth({"rows": []})
+
+
+def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
+    # crosscheck --contact sectioned --fem-json: the FEM results a report keeps are reused
+    # (no FEM run: the sectioned rod models only), and bench tradeoff --fem-sectioned adds
+    # the level's row with its contact width's miss
+    from tightknot.benchmarks.level_truth import format_table, level_truth
+    from tightknot.fem.crosscheck import crosscheck
+
+    sec = crosscheck(mesh="coarse", fem_results=report["fem_results"], contact="sectioned")
+    assert sec["contact"] == "sectioned" and sec["section_modes"] == 8
+    assert sec["fem_wall_time_s"] == report["fem_wall_time_s"]  # the same FEM runs
+    assert all(lv["rod_converged"] for s in sec["scenes"].values()
+               for lv in s["comparison"]["levels"])
+    rows = {r["level"]: r for r in level_truth(report, None, sec)["rows"]}
+    wc = [lv["width_fraction"] for s in sec["scenes"].values()
+          for lv in s["comparison"]["levels"] if lv["width_fraction"] is not None]
+    assert rows["sectioned"]["width_fraction_max"] == max(abs(w) for w in wc)
+    assert "| sectioned |" in format_table(level_truth(report, None, sec))
+    with pytest.raises(ValueError, match="sectioned level"):
+        level_truth(report, None, report)

@@ -9,7 +9,9 @@ reruns, two results:
   wrap scenes on one mesh against the rod model at the compliant level, and at the smoothed
   level in its ``smoothed_contact_level`` entry);
 - optionally the study's three knots at each level (``python bench/contact_levels.py
-  --json CL.json``: wall time and Newton iterations).
+  --json CL.json``: wall time and Newton iterations);
+- optionally a cross-check report of the sectioned level (``tightknot fem crosscheck
+  --contact sectioned --json XCS.json``), which adds its row, with the contact width's miss.
 
 Per level: the indent force's and the wrap's mid line load's error against the FEM at every
 compared load level (min and max), the largest area miss, the wrap's curvature miss, the rod
@@ -47,6 +49,7 @@ def _scene_errors(scenes: dict[str, Any]) -> dict[str, Any]:
         "wrap_line_load_rel": _range(wr, "force_rel"),
         "wrap_area_points_max": _max_abs(wr, "area_points"),
         "wrap_curvature_rel_max": _max_abs(wr, "curvature_rel"),
+        "width_fraction_max": _max_abs(ind + wr, "width_fraction"),
         "compared_levels": {"indent": len(ind), "wrap": len(wr)},
     }
 
@@ -67,11 +70,12 @@ def _knot_cost(contact_levels: dict | None, level: str) -> dict[str, Any] | None
             "time_ratio_to_compliant": [min(ratios), max(ratios)] if ratios else None}
 
 
-def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None
-                ) -> dict[str, Any]:
+def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None,
+                sectioned: dict[str, Any] | None = None) -> dict[str, Any]:
     """The table (module docstring) from a cross-check report and, optionally, the contact
-    levels' knot benchmark. Raises ValueError when ``crosscheck`` is not a cross-check
-    report."""
+    levels' knot benchmark and the sectioned level's cross-check report. Raises ValueError
+    when ``crosscheck`` is not a cross-check report of the compliant level, or
+    ``sectioned`` not one of the sectioned level."""
     if not isinstance(crosscheck, dict) or "scenes" not in crosscheck \
             or "smoothed_contact_level" not in crosscheck:
         raise ValueError("not a cross-check report (tightknot fem crosscheck --json F): it "
@@ -87,15 +91,25 @@ def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None
          "rod_wall_time_s": sm["rod_wall_time_s"],
          "fem_over_rod_time_ratio": sm["fem_over_rod_time_ratio"],
          "passed": sm["passed"], "knots": _knot_cost(contact_levels, "smoothed")},
-        {"level": "rigid", "fem_errors": None, "reason": RIGID_REASON,
-         "knots": _knot_cost(contact_levels, "rigid")},
     ]
+    if sectioned is not None:
+        if sectioned.get("contact") != "sectioned" or "scenes" not in sectioned:
+            raise ValueError("not a cross-check report of the sectioned level (tightknot fem "
+                             "crosscheck --contact sectioned --json F)")
+        rows.append({"level": "sectioned", **_scene_errors(sectioned["scenes"]),
+                     "section_modes": sectioned.get("section_modes"),
+                     "rod_wall_time_s": sectioned["rod_wall_time_s"],
+                     "fem_over_rod_time_ratio": sectioned["fem_over_rod_time_ratio"],
+                     "passed": sectioned["passed"],
+                     "knots": _knot_cost(contact_levels, "sectioned")})
+    rows.append({"level": "rigid", "fem_errors": None, "reason": RIGID_REASON,
+                 "knots": _knot_cost(contact_levels, "rigid")})
     return {"fem_mesh": crosscheck.get("mesh"), "fem_wall_time_s": fem_time,
             "targets": crosscheck.get("targets"), "rows": rows,
-            "not_covered": "two soft rods (the FEM's soft_crossing: the compliant and smoothed "
-                           "levels' pair law carries 0.55 to 0.66 of its force at the same "
-                           "per-rod approach, docs/fem_nip.md) and the sectioned level (not "
-                           "built; docs/sectioned_level.md)"}
+            "not_covered": "two soft rods (the FEM's soft_crossing, soft_wrap and clasp: "
+                           "docs/fem_nip.md)"
+                           + ("" if sectioned is not None else "; the sectioned level (add "
+                              "--fem-sectioned XCS.json)")}
 
 
 def _pct(r: list[float] | None) -> str:
@@ -107,21 +121,24 @@ def format_table(table: dict[str, Any]) -> str:
     lines = [f"contact levels against the FEM ({table['fem_mesh']} mesh, "
              f"{table['fem_wall_time_s']:.0f} s of FEM)",
              "| level | indent force | wrap line load | area, max [points] | wrap curvature, "
-             "max | rod time [s] | FEM / rod time | knots' time / compliant |",
-             "|---|---|---|---|---|---|---|---|"]
+             "max | L_c, max | rod time [s] | FEM / rod time | knots' time / compliant |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for row in table["rows"]:
         knots = row.get("knots")
         kt = ("n/a" if not knots or knots["time_ratio_to_compliant"] is None else
               f"{knots['time_ratio_to_compliant'][0]:.2f} .. "
               f"{knots['time_ratio_to_compliant'][1]:.2f}")
         if row["level"] == "rigid":
-            lines.append(f"| rigid | n/a ({RIGID_REASON}) | n/a | n/a | n/a | n/a | n/a | {kt} |")
+            lines.append(f"| rigid | n/a ({RIGID_REASON}) | n/a | n/a | n/a | n/a | n/a | n/a "
+                         f"| {kt} |")
             continue
         area = max(row["indent_area_points_max"] or 0.0, row["wrap_area_points_max"] or 0.0)
         lines.append(
             f"| {row['level']} | {_pct(row['indent_force_rel'])} | "
             f"{_pct(row['wrap_line_load_rel'])} | {100 * area:.1f} | "
             f"{100 * (row['wrap_curvature_rel_max'] or 0.0):.1f} % | "
-            f"{row['rod_wall_time_s']:.2f} | {row['fem_over_rod_time_ratio']:.0f} | {kt} |")
+            + ("n/a" if row["width_fraction_max"] is None
+               else f"{row['width_fraction_max']:.2f}")
+            + f" | {row['rod_wall_time_s']:.2f} | {row['fem_over_rod_time_ratio']:.0f} | {kt} |")
     lines.append(f"not covered: {table['not_covered']}")
     return "\n".join(lines)

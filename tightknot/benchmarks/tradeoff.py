@@ -314,6 +314,8 @@ _EXAMPLES = """examples:
   tightknot bench tradeoff --quick --json quick.json
   tightknot fem crosscheck --json xc.json && tightknot bench tradeoff --fem xc.json \
       --levels-json bench/contact_levels_results.json     # each contact level against the FEM
+  tightknot fem crosscheck --contact sectioned --fem-json xc.json --json xcs.json
+  tightknot bench tradeoff --fem xc.json --fem-sectioned xcs.json   # with the sectioned level
 """
 
 
@@ -332,6 +334,9 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
     p.add_argument("--fem", metavar="XC.json",
                    help="instead of the sweep: each contact level against the FEM, read from "
                    "a cross-check report (tightknot fem crosscheck --json XC.json)")
+    p.add_argument("--fem-sectioned", metavar="XCS.json",
+                   help="with --fem: the sectioned level's cross-check report (tightknot fem "
+                   "crosscheck --contact sectioned --json XCS.json)")
     p.add_argument("--levels-json", metavar="CL.json",
                    help="with --fem: the knots' cost per level (bench/contact_levels.py "
                    "--json CL.json)")
@@ -346,9 +351,9 @@ def _command(args) -> int:  # noqa: ANN001
 
     out = writable_file(args.json)
     if args.fem is not None:
-        return _truth_command(args.fem, args.levels_json, out)
-    if args.levels_json is not None:
-        raise ValueError("--levels-json goes with --fem")
+        return _truth_command(args.fem, args.levels_json, out, args.fem_sectioned)
+    if args.levels_json is not None or args.fem_sectioned is not None:
+        raise ValueError("--levels-json and --fem-sectioned go with --fem")
     budget = args.budget if args.budget is not None else (60.0 if args.quick else 180.0)
     if not (math.isfinite(budget) and budget > 0):
         raise ValueError(f"--budget must be finite and > 0 s, got {args.budget!r}")
@@ -367,7 +372,8 @@ def _command(args) -> int:  # noqa: ANN001
     return 0
 
 
-def _truth_command(fem: str, levels_json: str | None, out: Path | None) -> int:
+def _truth_command(fem: str, levels_json: str | None, out: Path | None,
+                   sectioned: str | None = None) -> int:
     """``bench tradeoff --fem XC.json``: the contact levels against the FEM."""
     import json
 
@@ -381,7 +387,8 @@ def _truth_command(fem: str, levels_json: str | None, out: Path | None) -> int:
             raise ValueError(f"{what} {path}: cannot read it as JSON ({exc})") from None
 
     table = level_truth(read(fem, "--fem"),
-                        read(levels_json, "--levels-json") if levels_json else None)
+                        read(levels_json, "--levels-json") if levels_json else None,
+                        read(sectioned, "--fem-sectioned") if sectioned else None)
     print(format_table(table))
     if out is not None:
         write_json_atomic(out, table)
