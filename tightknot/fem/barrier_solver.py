@@ -124,15 +124,26 @@ class BarrierProblem:
         r = r + self.contact.gradient() - self._external(self.load)
         return r, (k + self.contact.hessian(project=project)).tocsr()
 
-    def _assemble_solid(self) -> tuple[np.ndarray, sp.csr_matrix]:
+    def _set_state(self) -> None:
+        """Set the solid's condensed fields to the current displacements."""
         solid = self.solid
         state = solid.results.state
         v, vol = self._cell_volumes()
         state.u[:] = self.field[0].values
         state.J[:] = v / vol
         state.p[:] = solid.bulk * (v / vol - 1.0)  # exact Hessian (module docstring)
-        r = np.asarray(solid.assemble.vector(self.field).todense()).ravel()
-        return r, solid.assemble.matrix(self.field).tocsr()
+
+    def _assemble_solid(self) -> tuple[np.ndarray, sp.csr_matrix]:
+        self._set_state()
+        r = np.asarray(self.solid.assemble.vector(self.field).todense()).ravel()
+        return r, self.solid.assemble.matrix(self.field).tocsr()
+
+    def residual(self) -> np.ndarray:
+        """dPi/du [N or N/m] at the current displacements and load, over all dofs: at
+        the prescribed dofs, the forces that the supports exert on the bodies."""
+        self._set_state()
+        r = np.asarray(self.solid.assemble.vector(self.field).todense()).ravel()
+        return r + self.contact.gradient() - self._external(self.load)
 
     def _solve(self, k: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
         free = ~self.fixed

@@ -321,13 +321,17 @@ def _warm_up() -> float:
     return time.perf_counter() - start
 
 
-def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = None
-               ) -> dict[str, Any]:
-    """Run indent and wrap with the FEM (``mesh``) and the rod model and compare them.
+def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = None,
+               soft: bool = True) -> dict[str, Any]:
+    """Run indent and wrap with the FEM (``mesh``) and the rod model and compare them;
+    with ``soft``, also the two-soft-rod scenes soft_wrap and clasp
+    (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, its compliant level's
+    ``passed`` part of the report's).
 
-    ``fem_results`` may hold already computed FEM results (keys "indent", "wrap", run with
-    the default load levels) to reuse; their own ``wall_time_s`` then enters the ratio.
-    Returns the JSON-serialisable report (module docstring): per-scene comparisons,
+    ``fem_results`` may hold already computed FEM results (keys "indent", "wrap",
+    "soft_wrap", "clasp" and the soft scenes on the spread mesh, "soft_wrap@coarse" ...,
+    run with the default load levels) to reuse; their own ``wall_time_s`` then enters the
+    ratio. Returns the JSON-serialisable report (module docstring): per-scene comparisons,
     ``fem_over_rod_time_ratio``, ``passed``.
     """
     from . import run_scene
@@ -396,6 +400,11 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         "rod_at_least_1000x_faster": fem_time / rod_time >= 1000.0,
         "passed": (all(s["comparison"]["passed"] for s in scenes.values())
                    and fem_time / rod_time >= 1000.0),
-        "wall_time_s": time.perf_counter() - start,
     }
+    if soft:
+        from .crosscheck_soft import soft_rows
+
+        report["soft_scenes"] = soft_rows(mesh, fem_results)
+        report["passed"] = report["passed"] and report["soft_scenes"]["passed"]
+    report["wall_time_s"] = time.perf_counter() - start
     return finite(report)
