@@ -71,3 +71,20 @@ def test_cli_bad_input_is_one_line_exit_2(capsys):
     code = main(["fem", "clasp", "--pull", "5"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "max_pull_over_d0 must lie in (0, 2]" in err[0]
+
+
+@pytest.mark.slow
+def test_force_displacement_on_the_coarse_mesh():
+    # six pulls to 1 D0 (about 2 minutes alone, more on shared cores): nothing before
+    # the bends touch, then the force, the contact width and the constriction all grow
+    # (measured F = 0.0031 ... 0.0531 E D0^2 from 0.5 D0 on, docs/fem_nip.md)
+    from tightknot.fem import run_scene
+
+    res = run_scene("clasp", mesh="coarse")
+    steps = [s for s in res["steps"] if s["peak_pressure_over_e"] > 0.0]
+    assert 2 <= len(steps) < len(res["steps"])  # the first pulls only close the gap
+    for a, b in zip(steps, steps[1:], strict=False):
+        assert b["force"] > a["force"]
+        assert b["contact_fraction_max"] > a["contact_fraction_max"]
+        assert b["area_ratio_apex"] < a["area_ratio_apex"]
+        assert abs(b["force_balance_rel"]) < 1e-6

@@ -10,7 +10,7 @@ Public API::
     run_scene(name, mesh="coarse", max_approach_over_d0=None, steps=None, **options) -> dict
     SCENES  # "squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing", "soft_wrap", "clasp"
     calibration.calibrate(mesh="medium"), calibration.write_law(path)
-    crosscheck.crosscheck(mesh="coarse")  # FEM versus rod model on indent and wrap
+    crosscheck.crosscheck(mesh="coarse")  # FEM vs rod model: indent, wrap, soft_wrap, clasp
     commands.register(subparsers)  # CLI subcommands "fem", "calibrate", "fem crosscheck"
 """
 

@@ -19,8 +19,8 @@ pressure               peak contact pressure over E                        repor
 =====================  ==================================================  ==============
 
 The compared levels: the FEM's levels with an approach (``approach_over_d0``) of at most
-:data:`tightknot.fem.crosscheck.APPROACH_LIMIT` D0, and for the clasp also a pull force
-above zero (before the bends touch there is nothing to compare).
+:data:`tightknot.fem.crosscheck.APPROACH_LIMIT` D0 and a contact pressure (before the
+clasp's bends touch there is nothing to compare).
 
 Mesh spread (``fem_spread_rel``, per compared level): the relative difference of the
 compared FEM quantity between the comparison's mesh and the next coarser one (medium:
@@ -116,7 +116,8 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
     rows = []
     spread_steps = spread_steps or [None] * len(fem_steps)
     for f, r, c in zip(fem_steps, rod_steps, spread_steps, strict=True):
-        if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9 or f[f_key] <= 0.0:
+        # no contact yet (the clasp's bends apart): the FEM's force is round-off there
+        if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9 or f["peak_pressure_over_e"] <= 0.0:
             continue
         row = {
             "load": f.get("tension_over_e_d0sq", f.get("pull_over_d0")),

@@ -294,7 +294,8 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
             "pull_over_d0": pull / diameter,
             "force": f_pull,
             "force_over_e_d0sq": f_pull / (youngs_modulus * diameter**2),
-            "force_balance_rel": relative(f_contact, f_pull),
+            # before the bends touch both forces are round-off: nothing to balance
+            "force_balance_rel": relative(f_contact, f_pull) if pressure.max() > 0 else None,
             "approach_over_d0": (diameter - d) / diameter,
             "approach_nominal_over_d0": (diameter - d_nominal) / diameter,
             "axial_stretch_apex": stretch,
