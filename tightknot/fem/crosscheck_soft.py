@@ -36,7 +36,7 @@ from typing import Any
 
 from .scenes._common import MESH_LEVELS, relative
 
-SOFT_SCENES: tuple[str, ...] = ("soft_wrap", "clasp")
+ROW_SCENES: tuple[str, ...] = ("soft_wrap", "clasp")
 """The cross-check's scenes with two soft rods."""
 
 CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed")
@@ -58,7 +58,7 @@ def fem_runs(mesh: str, fem_results: dict[str, dict] | None = None) -> dict[str,
 
     out = dict(fem_results or {})
     spread = spread_mesh(mesh)
-    for name in SOFT_SCENES:
+    for name in ROW_SCENES:
         for level, key in ((mesh, name), (spread, f"{name}@{spread}")):
             if level is None or key in out:
                 continue
@@ -169,7 +169,7 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None) -> dict[str
         start = time.perf_counter()
         rod = _rod_runs(fem, contact)
         scenes = {}
-        for name in SOFT_SCENES:
+        for name in ROW_SCENES:
             ref = fem.get(f"{name}@{spread}") if spread else None
             scenes[name] = {
                 "comparison": compare(name, fem[name]["steps"], rod[name]["steps"],
@@ -194,7 +194,7 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None) -> dict[str
         "fem": {name: {"mesh": fem[name]["mesh"], "wall_time_s": fem[name]["wall_time_s"],
                        "steps": fem[name]["steps"],
                        "spread_steps": (fem[f"{name}@{spread}"]["steps"] if spread else None)}
-                for name in SOFT_SCENES},
+                for name in ROW_SCENES},
         "levels": levels,
         "passed": levels["compliant"]["passed"],
     }
