@@ -27,7 +27,8 @@ is set to K (v / V - 1), which :meth:`BarrierProblem.assemble` does.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -272,6 +273,20 @@ class BarrierProblem:
         """Step through the increasing loads; return ``measure(load)`` at each."""
         rows = []
         for target in loads:
-            self.iterations.append(self.advance(float(target)))
+            with self.failures_as_newton():
+                self.iterations.append(self.advance(float(target)))
             rows.append(measure(float(target)))
         return rows
+
+    @contextmanager
+    def failures_as_newton(self) -> Iterator[None]:
+        """Report a failure inside the contact library (ipctk's RuntimeError, e.g. a PSD
+        projection that fails on crossed surfaces, or its MemoryError from a CCD on a
+        runaway step) as :class:`BarrierNewtonFailure`: a failed solve, not a bug."""
+        try:
+            yield
+        except BarrierNewtonFailure:
+            raise
+        except (RuntimeError, MemoryError) as err:
+            raise BarrierNewtonFailure(f"the contact library failed at load "
+                                       f"{self.load:.6g}: {err}") from err

@@ -247,11 +247,12 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
     # at K = 5000 mu dwarfs the bending stresses and stalls Newton; a continuation in K
     # (10, 100 and 1000 mu, each to the intermediate tolerance) relaxes them first.
     relax = 0
-    for ratio in (10.0, 100.0, 1000.0):
-        solid.bulk = ratio * mu
-        relax += problem.correct(problem.intermediate_tol)
-    solid.bulk = bulk
-    relax += problem.correct()
+    with problem.failures_as_newton():
+        for ratio in (10.0, 100.0, 1000.0):
+            solid.bulk = ratio * mu
+            relax += problem.correct(problem.intermediate_tol)
+        solid.bulk = bulk
+        relax += problem.correct()
 
     lay_a = RodSections.from_section(section, radius, np.array([0.0, radius]), s_nodes, 0)
     lay_b = RodSections.from_section(section, radius, np.array([0.0, radius]), s_nodes,
