@@ -54,7 +54,6 @@ from ..material import (
     ROD_DIAMETER,
     SHEAR_MODULUS,
     YOUNGS_MODULUS,
-    nearly_incompressible_solid,
     poisson_ratio,
 )
 from ..measure import volume_ratio
@@ -68,7 +67,7 @@ from ._common import (
     mesh_convergence,
     relative,
 )
-from ._pair import GAP_OVER_DHAT, make_barrier, nodal_contact, stack
+from ._pair import GAP_OVER_DHAT, bodies_solid, make_barrier, nodal_contact
 from ._sections import RodSections
 
 REFINED_ARC_OVER_D0: float = 1.6
@@ -181,10 +180,8 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
     s_nodes = wrap.axial_nodes(length, REFINED_ARC_OVER_D0 * diameter,
                                AXIAL_FINE_CELLS[level], wrap.AXIAL_COARSE_CELLS[level])
     rod = extrude(section, s_nodes)
-    body, (idx_a, idx_b) = stack([rod, rod])
+    body, (idx_a, idx_b), field, solid = bodies_solid([rod, rod], youngs_modulus)
     ref = np.asarray(rod.points)
-    region = fem.RegionHexahedron(body)
-    field = fem.FieldContainer([fem.Field(region, dim=3)])
     lat = lateral_faces(rod, radius)
     near = np.all((ref[lat, 2] < (REFINED_ARC_OVER_D0 + 0.4) * diameter)
                   & (ref[lat, 1] > -0.5 * radius), axis=1)
@@ -223,7 +220,6 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
             break
         extra *= 2.0
     field[0].values[:] = u0
-    solid = nearly_incompressible_solid(field, mu=mu, bulk=bulk)
 
     tol = 1e-9 * diameter
     fixed = np.zeros((body.npoints, 3), dtype=bool)

@@ -47,14 +47,19 @@ from ..material import (
     ROD_DIAMETER,
     SHEAR_MODULUS,
     YOUNGS_MODULUS,
-    nearly_incompressible_solid,
     poisson_ratio,
 )
 from ..measure import volume_ratio
 from ..mesh import _HEX_FACES, extrude, lateral_faces, lumped_face_weights, quarter_disk
 from . import indent, wrap
 from ._common import check_dhat, finite, load_schedule, mesh_convergence
-from ._pair import contact_edge, make_barrier, nodal_contact, stack
+from ._pair import (
+    bodies_solid,
+    contact_edge,
+    make_barrier,
+    nodal_contact,
+    turned_about_x_eq_z,
+)
 from ._sections import RodSections
 
 GAP_OVER_DHAT: float = 0.5
@@ -115,7 +120,7 @@ def run(mesh: str = "coarse", max_tension_over_e_d0sq: float = 0.25,
 def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_deg: float,
              length_over_d0: float, diameter: float, youngs_modulus: float,
              dhat_over_d0: float) -> dict[str, Any]:
-    fem = require_felupe()
+    require_felupe()  # FElupe missing: the install hint, before any work
     from tightknot.knots.curvature import bergou_curvature
 
     start = time.perf_counter()
@@ -141,13 +146,8 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
                            wrap.AXIAL_FINE_CELLS[level], indent.AXIAL_COARSE_CELLS)
     local_b = extrude(sec_b, x_b)
     pb = local_b.points
-    # (x, y, z) -> (z, y_B - y, x): a proper rotation, hexahedra keep their orientation
-    rod_b = fem.Mesh(points=np.column_stack([pb[:, 2], y_b - pb[:, 1], pb[:, 0]]),
-                     cells=local_b.cells, cell_type="hexahedron")
-    body, (idx_a, idx_b) = stack([rod_a, rod_b])
-    region = fem.RegionHexahedron(body)
-    field = fem.FieldContainer([fem.Field(region, dim=3)])
-    solid = nearly_incompressible_solid(field, mu=mu, bulk=bulk)
+    rod_b = turned_about_x_eq_z(local_b, y_b)  # along e_x, facing A
+    body, (idx_a, idx_b), field, solid = bodies_solid([rod_a, rod_b], youngs_modulus)
     pts = body.points
     pa = rod_a.points
 
