@@ -70,6 +70,7 @@ import math
 import time
 from typing import Any
 
+from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .material import ROD_DIAMETER
 from .rod_model import rod_indent, rod_wrap
 from .scenes._common import MESH_LEVELS, finite, relative
@@ -79,16 +80,6 @@ DEFAULT_MESH: str = "medium"
 mesh differs from it by as much as the targets, so it cannot referee them
 (docs/fem_crosscheck.md)."""
 
-APPROACH_LIMIT: float = 0.25
-"""Largest approach over D0 at which the targets apply (the issue's range)."""
-
-TARGETS: dict[str, float] = {
-    "force_rel": 0.10,
-    "area_points": 0.05,
-    "curvature_rel": 0.10,
-}
-"""Targets: relative force and curvature differences, and area difference in points of
-A/A0 (absolute)."""
 
 def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str, str],
              kappa_key: str | None) -> dict[str, Any]:

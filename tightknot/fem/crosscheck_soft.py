@@ -19,7 +19,7 @@ pressure               peak contact pressure over E                        repor
 =====================  ==================================================  ==============
 
 The compared levels: the FEM's levels with an approach (``approach_over_d0``) of at most
-:data:`tightknot.fem.crosscheck.APPROACH_LIMIT` D0 and a contact pressure (before the
+:data:`tightknot.fem.crosscheck_targets.APPROACH_LIMIT` D0 and a contact pressure (before the
 clasp's bends touch there is nothing to compare).
 
 Mesh spread (``fem_spread_rel``, per compared level): the relative difference of the
@@ -34,6 +34,7 @@ from __future__ import annotations
 import time
 from typing import Any
 
+from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .scenes._common import MESH_LEVELS, relative
 
 ROW_SCENES: tuple[str, ...] = ("soft_wrap", "clasp")
@@ -104,7 +105,6 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
     pressure, each FEM value's mesh spread, and the targets met."""
     import numpy as np
 
-    from .crosscheck import APPROACH_LIMIT, TARGETS
 
     f_key, r_key, fa_key, ra_key, fk_key, rk_key, kappa_target = _KEYS[scene]
     # the clasp's force at the FEM's nominal approach (diagnostic): the rod model's force
