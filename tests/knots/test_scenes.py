@@ -25,7 +25,7 @@ def _length(x: np.ndarray, closed: bool) -> float:
 
 # -- bad input -------------------------------------------------------------------------------
 @pytest.mark.parametrize("kwargs, match", [
-    ({"contact": "soft"}, "contact must be one of compliant, smoothed, rigid, off"),
+    ({"contact": "soft"}, "contact must be one of compliant, smoothed, sectioned, rigid, off"),
     ({"twist": "yes"}, "twist must be True or False"),
     ({"contact": "off", "law": RadialComplianceLaw.hertz()}, "contact='off'"),
     ({"law": RadialComplianceLaw.hertz().rigid_tube()}, "use contact='rigid'"),

@@ -62,8 +62,11 @@ def test_no_progress_stops_as_stalled_within_the_window() -> None:
     prob = _Blocked()
     # step_tol is set out of reach so that only the no-progress test can end the loop early
     # (the blocked steps shrink, which the step-size test would otherwise catch).
+    # (blind_iterations off: the blocked steps' predicted decrease is below the round-off,
+    # which that test would catch first, see the next test)
     res = newton(prob, np.zeros(3), NewtonOptions(max_iterations=500, step_tol=1e-300,
-                                                  stall_iterations=40)).run()
+                                                  stall_iterations=40,
+                                                  blind_iterations=0)).run()
     assert not res.converged
     assert res.reason == "stalled"
     # It stops as soon as 40 iterations (the window) made no progress over the start, not at
@@ -72,15 +75,25 @@ def test_no_progress_stops_as_stalled_within_the_window() -> None:
     assert math.isfinite(res.residual)
 
 
+def test_steps_below_the_roundoff_stop_as_stalled() -> None:
+    # Blocked steps of 1e-14 predict decreases of ~1e-14, below the energy's round-off
+    # (1.5e-13): the energy cannot judge them and the residual does not fall, so after
+    # blind_iterations of them the solve stops, long before the window test's 40.
+    res = newton(_Blocked(), np.zeros(3), NewtonOptions(
+        max_iterations=500, step_tol=1e-300, stall_iterations=40, blind_iterations=10)).run()
+    assert res.reason == "stalled" and res.iterations == 10
+
+
 def test_stall_test_can_be_turned_off() -> None:
     res = newton(_Blocked(), np.zeros(3), NewtonOptions(
-        max_iterations=60, step_tol=1e-300, stall_iterations=0)).run()
+        max_iterations=60, step_tol=1e-300, stall_iterations=0, blind_iterations=0)).run()
     assert res.reason == "max_iterations" and res.iterations == 60
 
 
 @pytest.mark.parametrize("kw", [dict(stall_iterations=-1), dict(stall_iterations=2.5),
                                 dict(stall_factor=1.0), dict(stall_factor=math.nan),
-                                dict(stall_roundoffs=0.0), dict(max_iterations=0)])
+                                dict(stall_roundoffs=0.0), dict(max_iterations=0),
+                                dict(blind_iterations=-1)])
 def test_bad_newton_options_name_the_parameter(kw: dict) -> None:
     with pytest.raises(ValueError, match=next(iter(kw))):
         NewtonOptions(**kw)

@@ -31,9 +31,11 @@ def test_summary_covers_each_rod(clasps):
     assert [r["rod"] for r in s["rods"]] == ["A", "B"]
     for rod in s["rods"]:
         # Identical rods in a clasp symmetric but for the grips (A's clamped, B's ends
-        # dead-loaded: its grip's neighbour vertex slides along x): the same stretch between
-        # the grips to 1e-5 (measured 3.4e-6 apart at 10 N).
-        assert rod["stretch"] == pytest.approx(s["rods"][0]["stretch"], rel=1e-5)
+        # dead-loaded: its grip's neighbour vertex slides along x): nearly the same stretch
+        # between the grips. The sections thin with each rod's mean stretch, grips included,
+        # and A's clamped grips do not stretch: its sections are a little thicker (measured
+        # 1.1e-5 apart at 10 N; 3.4e-6 with each edge's own stretch thinning it).
+        assert rod["stretch"] == pytest.approx(s["rods"][0]["stretch"], rel=3e-5)
         assert rod["max_kappa_D0"] > 0.5  # a tight U-turn
         assert rod["contact_with_other_rod"]["vertices"] > 0
     assert s["tangle_type"]["kept"]

@@ -99,9 +99,9 @@ def register(subparsers: Any) -> None:
                    help="Poisson ratio of D = D0 [1 - nu (L - L0)/L0] (default 0.5)")
     p.add_argument("--radii", choices=("nominal", "stretch"), default="nominal",
                    help="radii of the contact test: nominal D0/2 (measured data; default), "
-                        "or stretch: each section thinned by its edge's stretch over a rod "
-                        "of equal rest edges of total --rest-length (a simulation's own "
-                        "measure: a tie's centerline.csv header asks for it)")
+                        "or stretch: each section thinned by the rod's mean stretch L/L0, "
+                        "L0 = --rest-length (a simulation's own measure at the default "
+                        "contact level: a tie's centerline.csv header asks for it)")
     p.add_argument("--json", default=None, metavar="OUT",
                    help="write every measurement to OUT as JSON (atomically; SI units)")
     p.add_argument("--figures", default=None, metavar="DIR",

@@ -26,6 +26,7 @@ from tightknot.loading.batch import BatchResult, tie_batch
 from tightknot.loading.tie import tie
 from tightknot.solvers.banded import single_blas_thread
 from tightknot.solvers.batch_eval import EvalRequest
+from tightknot.solvers.linear import LowRankHessian
 from tightknot.solvers.lockstep import BandedSolver, LinearStats
 from tightknot.solvers.system import RodSystem
 
@@ -57,7 +58,9 @@ def _batched_parts(batch: BatchResult, repeats: int = 9) -> dict[str, float]:
             t1 = time.perf_counter()
             for k, (s, solver) in enumerate(zip(systems, solvers, strict=True)):
                 ans = answers[k]
-                solver.shifted_direction(ans.hess, ans.grad[s.pattern.free_dofs], 0.0,
+                h = ans.hess if ans.low_rank is None else LowRankHessian(ans.hess,
+                                                                         *ans.low_rank)
+                solver.shifted_direction(h, ans.grad[s.pattern.free_dofs], 0.0,
                                          np.abs(ans.hess.data[ans.hess.diag_slot]))
             t2 = time.perf_counter()
             if rep:  # the first builds each rod's ordering (once per contact pattern)

@@ -127,3 +127,25 @@ class ContactChecks:
             return math.inf, -1, -1
         k = int(np.argmin(d))
         return float(d[k]), int(pr[k][0]), int(pr[k][1])
+
+
+def deepest_approaches(layer: object, x: np.ndarray, rest: np.ndarray
+                       ) -> tuple[float, float]:
+    """The largest per-side approach w = delta/2 [m] of the pairs of ``layer`` (a
+    :class:`tightknot.contact.layer.ContactLayer`) at positions ``x`` [m] and edge rest
+    lengths ``rest`` [m], among parallel pairs (crossing angle below the law's
+    ``angle_line_deg``: line contact) and among crossing pairs (point contact, or the
+    blend toward it); 0 where none touches."""
+    layer.evaluate(x, rest, False, False)
+    pairs, overlap = layer.last_pairs, layer.last_overlap
+    touch = overlap > 0.0
+    if not touch.any():
+        return 0.0, 0.0
+    pr, w = pairs[touch], 0.5 * overlap[touch]
+    ev = layer.model.edge_vertex
+    ta = x[ev[pr[:, 0], 1]] - x[ev[pr[:, 0], 0]]
+    tb = x[ev[pr[:, 1], 1]] - x[ev[pr[:, 1], 0]]
+    cos = np.abs(np.einsum("ij,ij->i", ta, tb)) / (np.linalg.norm(ta, axis=1)
+                                                    * np.linalg.norm(tb, axis=1))
+    line = cos >= math.cos(math.radians(layer.law.angle_line_deg))
+    return (float(w[line].max(initial=0.0)), float(w[~line].max(initial=0.0)))

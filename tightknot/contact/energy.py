@@ -5,7 +5,10 @@ candidate pairs at the positions, and the pair kernel (:mod:`tightknot.contact.p
 gives their energies, the gradient and the Hessian, as COO triplets over global dofs or
 added into the system's CSC data. With a radius window the contact radius is the smoothed
 one (:mod:`tightknot.contact.section_radius`), given to the kernel; its chain rule adds a
-gradient term and Hessian terms that couple whole windows.
+gradient term and Hessian terms that couple whole windows. Thinned by each rod's mean
+stretch (:mod:`tightknot.contact.rod_mean_radius`) the radius is given to the kernel too;
+its chain rule adds a gradient term, terms in the edges' stretch blocks and a dense update
+of low rank.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import warp as wp
 
 from tightknot.contact.broad_phase import BroadPhase
 from tightknot.contact.pair_kernel import Hessian, PairKernel, PairTerms
+from tightknot.contact.rod_mean_radius import RodMeanRadius
 from tightknot.contact.section_radius import SmoothedRadius
 from tightknot.rods.model import Model
 from tightknot.rods.staging import Staging
@@ -35,15 +39,22 @@ class ContactEnergy:
         broad: the layer's broad phase.
         kernel: the pair kernel's launcher.
         smooth: the smoothed contact radius (None: each edge's own stretch thins it).
+        mean: the radius thinned by each rod's mean stretch (None: not; not with
+            ``smooth``).
     """
 
     def __init__(self, model: Model, broad: BroadPhase, kernel: PairKernel,
-                 smooth: SmoothedRadius | None) -> None:
+                 smooth: SmoothedRadius | None, mean: RodMeanRadius | None = None) -> None:
+        if smooth is not None and mean is not None:
+            raise ValueError("a contact radius is smoothed over a window or thinned by the "
+                             "rod's mean stretch, not both")
         self.model = model
         self.broad = broad
         self.kernel = kernel
         self.smooth = smooth
-        self._in_radius = Staging(wp.float64, model.device) if smooth is not None else None
+        self.mean = mean
+        given = smooth is not None or mean is not None
+        self._in_radius = Staging(wp.float64, model.device) if given else None
         #: Candidate pairs (P, 2) of the last evaluation and their overlaps [m] (P,).
         self.last_pairs = np.zeros((0, 2), dtype=np.int32)
         self.last_overlap = np.zeros(0)
@@ -101,7 +112,13 @@ class ContactEnergy:
             cols = np.broadcast_to(dofs[:, None, :], (npairs, 12, 12)).ravel()
             coo = (rows, cols, hvals)
         if geo is not None and (want_grad or want_hess):
-            g_s, h_s = self._smoothed_terms(geo, e_pair, want_hess)
+            if self.mean is not None:
+                g_s, h_s, low = self._mean_terms(geo, e_pair, want_hess)
+                if h_s is not None and low is not None:
+                    # Dense here (tests and diagnostics; the solver keeps it low-rank).
+                    h_s = _with_dense(h_s, *low)
+            else:
+                g_s, h_s = self._smoothed_terms(geo, e_pair, want_hess)
             if g is not None:
                 g += g_s
             if coo is not None:
@@ -116,7 +133,10 @@ class ContactEnergy:
         new contacts missing from the tables are signalled by None for the gradient: the
         caller grows its pattern by :meth:`missing_blocks` and calls again. With a radius
         window a third item holds the Hessian terms of the smoothed radius (COO over global
-        dofs), which couple whole windows and so lie outside the pair blocks."""
+        dofs), which couple whole windows and so lie outside the pair blocks; with the
+        rod's mean stretch a third item holds the terms in the edges' stretch blocks (COO)
+        and a fourth the dense update (U, C) over global dofs, or None
+        (:mod:`tightknot.contact.rod_mean_radius`)."""
         geo = self._geometry(x, rest)
         out = self.launch(x, rest, True, Hessian.CSC, tables, data,
                           radius=self._radius_array(geo))
@@ -127,6 +147,9 @@ class ContactEnergy:
         g = out.grad.numpy().copy()
         if geo is None:
             return float(e_pair.sum()), g
+        if self.mean is not None:
+            g_s, h_s, low = self._mean_terms(geo, e_pair, True)
+            return float(e_pair.sum()), g + g_s, h_s, low
         g_s, h_s = self._smoothed_terms(geo, e_pair, True)
         return float(e_pair.sum()), g + g_s, h_s
 
@@ -152,11 +175,15 @@ class ContactEnergy:
         """The stretch that thins each edge's section [-]: its own, or the window mean."""
         if self.smooth is not None:
             return self.smooth.stretch(x, np.asarray(rest, dtype=np.float64))
+        if self.mean is not None:
+            return self.mean.stretch(x, rest)
         ev = self.model.edge_vertex
         return np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1) / rest
 
     def _geometry(self, x: np.ndarray, rest: np.ndarray) -> dict[str, np.ndarray] | None:
-        """Tangents, lengths, smoothed radii and their derivatives (None without window)."""
+        """Tangents, lengths, given radii and their derivatives (None: each edge's own)."""
+        if self.mean is not None:
+            return self.mean.radii(x, rest)
         if self.smooth is None:
             return None
         return self.smooth.radii(x, np.asarray(rest, dtype=np.float64))
@@ -175,3 +202,33 @@ class ContactEnergy:
             return g, None
         return g, self.smooth.hessian(geo, pr, self.pair_dofs(pr), d_r[:, 1], d_r[:, 2:],
                                       big_g, c)
+
+    def _mean_terms(self, geo: dict[str, np.ndarray], e_pair: np.ndarray, want_hess: bool
+                    ) -> tuple[np.ndarray, tuple | None, tuple | None]:
+        """The mean-stretch radius's gradient term (V, 3) [N], its Hessian terms in the
+        edges' stretch blocks (COO over global dofs) and its low-rank update (U, C) or
+        None; both Hessian items None without ``want_hess``."""
+        active = np.flatnonzero(e_pair != 0.0)
+        pr = self.last_pairs[active]
+        d_r = self.kernel.radius_derivatives(e_pair.size)[active]
+        mean = self.mean
+        g, big_g = mean.gradient(geo, pr, d_r[:, 0])
+        if not want_hess:
+            return g, None, None
+        blk = mean.stretch_blocks(geo, big_g)
+        ed = mean.edge_dofs
+        coo = (np.repeat(ed, 6, axis=1).ravel(), np.tile(ed, (1, 6)).ravel(), blk.ravel())
+        low = mean.low_rank(geo, pr, self.pair_dofs(pr), d_r[:, 0], d_r[:, 1], d_r[:, 2:])
+        return g, coo, low
+
+
+def _with_dense(coo: tuple[np.ndarray, np.ndarray, np.ndarray], u: np.ndarray,
+                c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """COO triplets ``coo`` with the dense U C U^T added on the rows where U is not zero."""
+    rows = np.flatnonzero(np.any(u != 0.0, axis=1))
+    ur = u[rows]
+    dense = ur @ c @ ur.T
+    r = np.repeat(rows, rows.size)
+    k = np.tile(rows, rows.size)
+    return (np.concatenate([coo[0], r]), np.concatenate([coo[1], k]),
+            np.concatenate([coo[2], dense.ravel()]))

@@ -97,6 +97,10 @@ class RadialComplianceLaw:
             (:func:`tightknot.fem.calibration.calibrate_core`); None: the layer's defaults.
         calibrated_w_hat: the largest per-side approach w/D the law (with its core) was
             calibrated to [-]: a state beyond it is outside the calibrated range.
+        power_w_hat: the largest w/D the power laws were fitted to [-] (the FEM's squeeze
+            and indent); the core, fitted to plane-strain squeezes, carries the line
+            contact on to ``calibrated_w_hat``, so a crossing (point contact) deeper than
+            this is extrapolated.
         source: where the parameters come from.
     """
 
@@ -124,6 +128,7 @@ class RadialComplianceLaw:
     core_hard_relative: float | None = None
     core_stiffness: float | None = None
     calibrated_w_hat: float = 0.15
+    power_w_hat: float = 0.15
     source: str = "parameters"
 
     def __post_init__(self) -> None:
@@ -156,6 +161,8 @@ class RadialComplianceLaw:
         d = json.loads(text)
         keys = {f for f in cls.__dataclass_fields__}
         kw = {k: float(v) for k, v in d.items() if k in keys and isinstance(v, (int, float))}
+        if "w_hat_max" in d:
+            kw["power_w_hat"] = float(d["w_hat_max"])
         if "k_patch" not in kw and "k_patch_axial" in d:
             kw["k_patch"] = float(d["k_patch_axial"])
             kw["p_patch"] = float(d["p_patch_axial"])

@@ -33,6 +33,7 @@ from tightknot.contact.energy import ContactEnergy, pair_blocks
 from tightknot.contact.law import RadialComplianceLaw
 from tightknot.contact.pair_kernel import PairKernel
 from tightknot.contact.pair_law import pair_law
+from tightknot.contact.rod_mean_radius import RodMeanRadius
 from tightknot.contact.section_radius import SmoothedRadius
 from tightknot.contact.settings import ContactSettings
 from tightknot.contact.step_bound import StepBound
@@ -83,6 +84,10 @@ class ContactLayer(EnergyTerm):
             knots tie in about as many Newton iterations; each iteration costs more (the
             Hessian couples whole windows; docs/fem_crosscheck.md). Not with a rigid-tube
             law (its radius does not thin), not in the batch (:mod:`tightknot.loading.batch`).
+        thinning: "edge" (default): each edge's own stretch thins its section (or the
+            window mean, ``radius_window``); "rod": every section of a rod thins with the
+            rod's mean stretch L/L0 (:mod:`tightknot.contact.rod_mean_radius`: the contact
+            then pulls no edge apart; the default level of the scenes).
     """
 
     name = "contact"
@@ -104,6 +109,7 @@ class ContactLayer(EnergyTerm):
         local_thickness: bool = False,
         initial_capacity: int = 1024,
         radius_window: float = 0.0,
+        thinning: str = "edge",
     ) -> None:
         init_warp()
         self.law = law or RadialComplianceLaw.from_json()
@@ -126,11 +132,13 @@ class ContactLayer(EnergyTerm):
             gauss_points=gauss_points, exclusion_factor=exclusion_factor,
             hard_fraction=float(hard_fraction), core_fraction=float(core_fraction),
             core_stiffness=float(core_stiffness), hard_relative=float(hard_relative),
-            local_thickness=bool(local_thickness), radius_window=float(radius_window))
+            local_thickness=bool(local_thickness), radius_window=float(radius_window),
+            thinning=thinning)
         st = self.settings
-        if st.radius_window > 0.0 and rigid:
-            raise ValueError("radius_window needs a compliant law: a rigid tube's "
-                             "radius does not thin with stretch")
+        if (st.radius_window > 0.0 or st.thinning == "rod") and rigid:
+            raise ValueError(f"{'radius_window' if st.radius_window > 0.0 else 'thinning=rod'} "
+                             "needs a compliant law: a rigid tube's radius does not thin "
+                             "with stretch")
         m = model
         self.model = model
         self.device = model.device
@@ -150,7 +158,8 @@ class ContactLayer(EnergyTerm):
                                                   initial_capacity)
         kernel = PairKernel(self.broad_phase, pair_law(self.law, st, self.device), st.gauss,
                             m.edge_radius, nu, self.edge_modulus)
-        self.energy = ContactEnergy(m, self.broad_phase, kernel, smooth)
+        mean = RodMeanRadius(m, nu) if st.thinning == "rod" else None
+        self.energy = ContactEnergy(m, self.broad_phase, kernel, smooth, mean)
         self.step_bound = StepBound(self.broad_phase, st.hard_fraction * self.edge_diameter,
                                     self.edge_diameter)
         self.checks = ContactChecks(self.broad_phase, self.step_bound, st.hard_fraction)
@@ -175,6 +184,11 @@ class ContactLayer(EnergyTerm):
     def radius_window(self) -> float:
         """Half-width of the smoothed radius's window [D0] (0: none)."""
         return self.settings.radius_window
+
+    @property
+    def thinning(self) -> str:
+        """The stretch that thins the contact radius: "edge" or "rod" (the rod's mean)."""
+        return self.settings.thinning
 
     @property
     def section_radius(self) -> SmoothedRadius | None:
@@ -240,9 +254,18 @@ class ContactLayer(EnergyTerm):
         for the deformed rod: its arc grows as lam and its diameter thins as lam^-nu, so in
         rest arcs and rest diameters the window shrinks by lam^(1 + nu). A pair that a
         stretched, thinned knot brings into contact is then no longer taken for a
-        neighbour. Compressed edges keep the rest window (it never widens)."""
-        lam = np.asarray(lengths, dtype=np.float64) / np.asarray(rest, dtype=np.float64)
-        return np.maximum(lam, 1.0) ** (1.0 + self.edge_poisson[edges])
+        neighbour. Compressed edges keep the rest window (it never widens). With
+        ``thinning="rod"`` the diameter thins with the rod's mean stretch s instead:
+        max(lam, 1) max(s, 1)^nu."""
+        lengths = np.asarray(lengths, dtype=np.float64)
+        rest = np.asarray(rest, dtype=np.float64)
+        lam = lengths / rest
+        nu = self.edge_poisson[edges]
+        if self.settings.thinning == "rod":
+            rod = self.model.edge_rod[edges]
+            s = np.bincount(rod, lengths)[rod] / np.bincount(rod, rest)[rod]
+            return np.maximum(lam, 1.0) * np.maximum(s, 1.0) ** nu
+        return np.maximum(lam, 1.0) ** (1.0 + nu)
 
     def begin_load_step(self, x: np.ndarray, rest: np.ndarray) -> None:
         """At a new load step, the window follows the rod as it is at the step's start

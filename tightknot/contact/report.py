@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from tightknot.contact.layer import ContactLayer
+from tightknot.contact.sectioned import SectionedLayer
+from tightknot.rods.state import State
 
 
 @dataclass
@@ -60,9 +62,14 @@ def _segment_closest(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
 
 
 def contact_report(layer: ContactLayer, x: np.ndarray,
-                   rest: np.ndarray | None = None) -> ContactReport:
+                   rest: np.ndarray | None = None, state: State | None = None
+                   ) -> ContactReport:
     """Per-vertex contact outputs of the state ``x`` [m] with edge rest lengths ``rest``
-    [m] (default: those of the layer's last evaluation), derived from the law's fits.
+    [m] (default: those of the layer's last evaluation), derived from the law's fits; at
+    the sectioned level (:class:`tightknot.contact.sectioned.SectionedLayer`) the width,
+    pressures, force and area come from the sections of ``state`` instead
+    (:meth:`~tightknot.contact.sectioned.SectionedLayer.section_report`; the overlaps, of
+    the nominal stretched radii, say how far the sections are flattened).
 
     For every non-local edge pair in contact, the closest points of the two segments give
     the distance d, the pair overlap delta = R - d (R = r_a + r_b, stretched radii) and the
@@ -166,8 +173,18 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
         p_peak = (1 - xiv) * law.peak_pressure_line(w1v, dv) + xiv * law.peak_pressure_point(
             w1v, dv)
         area = law.area_factor(0.5 * (w1v + w2v), dv) / stretch_v
+    force = f_line * emod
+    if isinstance(layer, SectionedLayer):
+        if state is None:
+            raise ValueError("the sectioned contact level's report needs the state (its "
+                             "sections)")
+        sec = layer.section_report(x, state.extra, (state.t_ref, state.d1_ref, state.m_ref),
+                                   rest)
+        half, lc, area = sec["half_width"], sec["contact_width_fraction"], sec["area_ratio"]
+        p_mean, p_peak = sec["mean_pressure_over_E"], sec["peak_pressure_over_E"]
+        force = sec["force_per_length"]
     return ContactReport(
         overlap=2.0 * w1v, overlap_opposite=2.0 * w2v,
-        force_per_length=f_line * emod, half_width=half, contact_width_fraction=lc,
+        force_per_length=force, half_width=half, contact_width_fraction=lc,
         mean_pressure_over_E=p_mean, peak_pressure_over_E=p_peak, area_ratio=area,
         pairs=pair_list)

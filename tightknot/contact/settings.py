@@ -18,6 +18,10 @@ GAUSS = {
 }
 
 
+#: The stretches that can thin the contact radius (ContactSettings.thinning).
+THINNING = ("edge", "rod")
+
+
 @dataclass(frozen=True)
 class ContactSettings:
     """Settings of a :class:`tightknot.contact.layer.ContactLayer` (see its docstring for
@@ -35,6 +39,8 @@ class ContactSettings:
             half of it.
         radius_window: half-width [D0] of the window that averages the stretch thinning
             the contact radius (0: each edge's own stretch).
+        thinning: the stretch that thins the contact radius: "edge" (each edge's own, or
+            its window mean with ``radius_window``) or "rod" (the rod's mean stretch L/L0).
     """
 
     gauss_points: int = 2
@@ -45,8 +51,15 @@ class ContactSettings:
     hard_relative: float = 0.0
     local_thickness: bool = False
     radius_window: float = 0.0
+    thinning: str = "edge"
 
     def __post_init__(self) -> None:
+        if self.thinning not in THINNING:
+            raise ValueError(f"thinning must be one of {', '.join(THINNING)}, got "
+                             f"{self.thinning!r}")
+        if self.thinning == "rod" and self.radius_window != 0.0:
+            raise ValueError("thinning='rod' takes no radius_window (the rod's mean stretch "
+                             f"thins every section), got radius_window={self.radius_window!r}")
         rw = self.radius_window
         if not (math.isfinite(rw) and 0.0 <= rw <= 10.0):
             raise ValueError(f"radius_window must be in [0, 10] (D0), got {rw!r}")

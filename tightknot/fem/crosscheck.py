@@ -80,13 +80,31 @@ DEFAULT_MESH: str = "medium"
 mesh differs from it by as much as the targets, so it cannot referee them
 (docs/fem_crosscheck.md)."""
 
+CONTACT_LEVELS: tuple[str, ...] = ("compliant", "sectioned")
+"""Rod-model contact levels the cross-check runs as its subject: the compliant level
+(with the smoothed one beside it) or the sectioned level (:mod:`tightknot.fem.rod_sectioned`).
+"""
+
+
+def fem_width_fraction(step: dict[str, Any], scene: str) -> float | None:
+    """The FEM's contact width fraction L_c of the mid section: the contact arcs (chords of
+    the measured semi-axes: two indenters of half-width a across the rod, or the wrap's one
+    contact of half-width b) over the deformed perimeter pi D0 sqrt(A/A0)."""
+    perimeter = math.pi * math.sqrt(step["area_ratio_mid"])
+    if scene == "indent":
+        a = step.get("semi_axis_transverse_over_d0")
+        return None if a is None else 4.0 * a / perimeter
+    b = step.get("contact_half_width_mid_over_d0")
+    return None if b is None else 2.0 * b / perimeter
 
 def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str, str],
-             kappa_key: str | None) -> dict[str, Any]:
+             kappa_key: str | None, width_scene: str | None = None) -> dict[str, Any]:
     """Per-level comparison up to ``APPROACH_LIMIT`` (gated on the FEM's
     ``approach_over_d0``). ``force_keys``: (FEM key, rod key) of the compared force;
     ``kappa_key``: the FEM key of the axis curvature compared with the rod's
-    ``kappa_d0_mid`` (None: not compared)."""
+    ``kappa_d0_mid`` (None: not compared); ``width_scene``: compare the mid section's
+    contact width fraction (the rod's ``contact_width_fraction_mid``) with the FEM's
+    (:func:`fem_width_fraction` of that scene), None: not compared."""
     fem_force, rod_force = force_keys
     rows = []
     for f, r in zip(fem_steps, rod_steps, strict=True):
@@ -114,10 +132,18 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
         }
         if kappa_key is not None:
             row["met"]["curvature"] = abs(row["curvature_rel"]) <= TARGETS["curvature_rel"]
+        if width_scene is not None:
+            lc = fem_width_fraction(f, width_scene)
+            row.update(fem_width_fraction=lc, rod_width_fraction=r["contact_width_fraction_mid"],
+                       width_fraction=None if lc is None
+                       else r["contact_width_fraction_mid"] - lc)
+            row["met"]["width"] = (row["width_fraction"] is not None
+                                   and abs(row["width_fraction"]) <= TARGETS["width_fraction"])
         rows.append(row)
-    worst = {k: max((abs(x[k]) for x in rows), default=None)
+    worst = {k: max((abs(x[k]) for x in rows if x.get(k) is not None), default=None)
              for k in ("force_rel", "area_points", "pressure_rel")
-             + (("curvature_rel",) if kappa_key is not None else ())}
+             + (("curvature_rel",) if kappa_key is not None else ())
+             + (("width_fraction",) if width_scene is not None else ())}
     return {"levels": rows, "worst": worst,
             "passed": bool(rows) and all(all(x["met"].values()) for x in rows)}
 
@@ -313,22 +339,31 @@ def _warm_up() -> float:
 
 
 def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = None,
-               soft: bool = True) -> dict[str, Any]:
-    """Run indent and wrap with the FEM (``mesh``) and the rod model and compare them;
-    with ``soft``, also the two-soft-rod scenes soft_wrap and clasp
-    (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, its compliant level's
-    ``passed`` part of the report's).
+               contact: str = "compliant", section_modes: int = 8, soft: bool = True
+               ) -> dict[str, Any]:
+    """Run indent and wrap with the FEM (``mesh``) and the rod model at the contact level
+    ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N) and
+    compare them; at the compliant level with ``soft``, also the two-soft-rod scenes
+    soft_wrap and clasp (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, its
+    compliant level's ``passed`` part of the report's).
 
     ``fem_results`` may hold already computed FEM results (keys "indent", "wrap",
     "soft_wrap", "clasp" and the soft scenes on the spread mesh, "soft_wrap@coarse" ...,
-    run with the default load levels) to reuse; their own ``wall_time_s`` then enters the
-    ratio. Returns the JSON-serialisable report (module docstring): per-scene comparisons,
-    ``fem_over_rod_time_ratio``, ``passed``.
+    run with the default load levels, as a report's ``fem_results`` keeps them) to reuse;
+    their own ``wall_time_s`` then enters the ratio. Returns the JSON-serialisable report
+    (module docstring): per-scene comparisons, ``fem_over_rod_time_ratio``, ``passed``.
     """
     from . import run_scene
 
     if mesh not in MESH_LEVELS:
         raise ValueError(f"mesh must be one of {MESH_LEVELS}, got {mesh!r}")
+    if contact not in CONTACT_LEVELS:
+        raise ValueError(f"contact must be one of {', '.join(CONTACT_LEVELS)}, got "
+                         f"{contact!r}")
+    if contact == "sectioned":
+        from tightknot.contact.sectioned import SectionSettings
+
+        SectionSettings(max_mode=section_modes)  # bad input before the FEM runs
     fem_results = dict(fem_results or {})
     start = time.perf_counter()
     if "indent" not in fem_results:
@@ -336,6 +371,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     if "wrap" not in fem_results:
         fem_results["wrap"] = run_scene("wrap", mesh=mesh, convergence=False)
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
+    if contact == "sectioned":
+        return _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start)
     warm = _warm_up()
     rod_ind = _rod_indent_like(fem_ind)
     rod_wr = _rod_wrap_like(fem_wrap)
@@ -391,11 +428,86 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         "rod_at_least_1000x_faster": fem_time / rod_time >= 1000.0,
         "passed": (all(s["comparison"]["passed"] for s in scenes.values())
                    and fem_time / rod_time >= 1000.0),
+        "contact": "compliant",
+        "fem_results": {"indent": fem_ind, "wrap": fem_wrap},
     }
     if soft:
-        from .crosscheck_soft import soft_rows
+        from .crosscheck_soft import fem_runs, soft_rows
 
+        fem_results = fem_runs(mesh, fem_results)
         report["soft_scenes"] = soft_rows(mesh, fem_results)
+        report["fem_results"].update({k: v for k, v in fem_results.items()
+                                      if k not in ("indent", "wrap")})
         report["passed"] = report["passed"] and report["soft_scenes"]["passed"]
     report["wall_time_s"] = time.perf_counter() - start
+    return finite(report)
+
+
+def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
+                      section_modes: int, start: float) -> dict[str, Any]:
+    """The cross-check of the sectioned level (:mod:`tightknot.fem.rod_sectioned`): force,
+    A/A0, L_c and (wrap) curvature at every level, against the targets."""
+    from tightknot.contact.sectioned import SectionSettings
+
+    from .rod_sectioned import rod_indent_sectioned, rod_wrap_sectioned
+
+    section = SectionSettings(max_mode=section_modes)
+    t0 = time.perf_counter()
+    rod_indent_sectioned([0.01 * ROD_DIAMETER], length_over_d0=1.5, section=section)
+    warm = time.perf_counter() - t0
+    rod_ind = _rod_indent_like(fem_ind, rod_indent_sectioned, section=section)
+    rod_wr = _rod_wrap_like(fem_wrap, rod_wrap_sectioned, section=section)
+    fem_time = fem_ind["wall_time_s"] + fem_wrap["wall_time_s"]
+    rod_time = rod_ind["wall_time_s"] + rod_wr["wall_time_s"]
+    scenes = {
+        "indent": {
+            "force": "force on one side [N] (point contact)",
+            "fem_mesh": fem_ind["mesh"], "fem_wall_time_s": fem_ind["wall_time_s"],
+            "rod_wall_time_s": rod_ind["wall_time_s"], "rod_vertices": rod_ind["vertices"],
+            "comparison": _compare(fem_ind["steps"], rod_ind["steps"], ("force", "force"),
+                                   None, width_scene="indent"),
+            "fem_steps": fem_ind["steps"], "rod_steps": rod_ind["steps"],
+        },
+        "wrap": {
+            "force": "contact line load at the middle of the wrap [N/m] (nominal axis)",
+            "fem_mesh": fem_wrap["mesh"], "fem_wall_time_s": fem_wrap["wall_time_s"],
+            "rod_wall_time_s": rod_wr["wall_time_s"], "rod_vertices": rod_wr["vertices"],
+            "comparison": _compare(fem_wrap["steps"], rod_wr["steps"],
+                                   ("force_per_length_mid_nominal", "force_per_length_mid"),
+                                   "kappa_d0_mid_nominal", width_scene="wrap"),
+            "centroid_axis": [
+                {"tension_over_e_d0sq": f["tension_over_e_d0sq"],
+                 "fem_kappa_d0_centroid": f["kappa_d0_mid"],
+                 "rod_kappa_d0_centroid": r["kappa_d0_mid_centroid"],
+                 "curvature_rel_centroid": relative(r["kappa_d0_mid_centroid"],
+                                                    f["kappa_d0_mid"]),
+                 "force_rel_centroid_axis": relative(r["force_per_length_mid_centroid"],
+                                                     f["force_per_length_mid"]),
+                 "rod_kappa_d0_centerline": r["kappa_d0_mid_centerline"]}
+                for f, r in zip(fem_wrap["steps"], rod_wr["steps"], strict=True)
+                if f["approach_over_d0"] <= APPROACH_LIMIT + 1e-9],
+            "fem_steps": fem_wrap["steps"], "rod_steps": rod_wr["steps"],
+        },
+    }
+    report = {
+        "schema": "tightknot.fem_crosscheck/1",
+        "contact": "sectioned",
+        "section_modes": section_modes,
+        "penalty_over_e_per_d0": rod_ind["penalty"],
+        "mesh": mesh,
+        "approach_limit_over_d0": APPROACH_LIMIT,
+        "targets": TARGETS,
+        "calibration": "tightknot/data/section_calibration.json (the penalty fitted to the "
+                       "FEM's plane-strain squeeze; the decay lengths from rod_mode_decay)",
+        "scenes": scenes,
+        "fem_wall_time_s": fem_time,
+        "rod_wall_time_s": rod_time,
+        "rod_warm_up_s": warm,
+        "fem_over_rod_time_ratio": fem_time / rod_time,
+        "rod_at_least_1000x_faster": fem_time / rod_time >= 1000.0,
+        "passed": (all(s["comparison"]["passed"] for s in scenes.values())
+                   and fem_time / rod_time >= 1000.0),
+        "wall_time_s": time.perf_counter() - start,
+        "fem_results": {"indent": fem_ind, "wrap": fem_wrap},
+    }
     return finite(report)

@@ -10,6 +10,8 @@ TARGETS: dict[str, float] = {
     "force_rel": 0.10,
     "area_points": 0.05,
     "curvature_rel": 0.10,
+    "width_fraction": 0.10,
 }
-"""Targets: relative force and curvature differences, and area difference in points of
-A/A0 (absolute)."""
+"""Targets: relative force and curvature differences, area difference in points of A/A0
+(absolute), and (sectioned level) the mid section's contact width fraction L_c (absolute).
+"""

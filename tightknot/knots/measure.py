@@ -186,23 +186,13 @@ def analyze_centerline(
 
 def stretch_radii(points: np.ndarray, diameter: float, rest_length: float, poisson: float,
                   closed: bool) -> np.ndarray:
-    """Per-vertex radii [m] of a rod of equal rest edges (length ``rest_length`` [m]) whose
-    sections thin with their edges' stretch: r0 lambda^-nu per edge (the incompressible
-    section of :func:`tightknot.knots.scenes.vertex_radii`), averaged onto the vertices."""
+    """Per-vertex radii [m] of a rod of rest length ``rest_length`` [m] whose sections thin
+    with its mean stretch lambda = L/L0: r0 lambda^-nu at every vertex (the default contact
+    level's sections, :func:`tightknot.knots.scenes.vertex_radii`)."""
     e = np.linalg.norm((np.roll(points, -1, axis=0) - points) if closed
                        else np.diff(points, axis=0), axis=1)
-    lam = e / (rest_length / e.size)
-    r_e = 0.5 * diameter * lam ** (-poisson)
-    n = points.shape[0]
-    r_v = np.zeros(n)
-    cnt = np.zeros(n)
-    first = np.arange(e.size)
-    second = (first + 1) % n
-    np.add.at(r_v, first, r_e)
-    np.add.at(r_v, second, r_e)
-    np.add.at(cnt, first, 1.0)
-    np.add.at(cnt, second, 1.0)
-    return r_v / cnt
+    lam = float(e.sum()) / rest_length
+    return np.full(points.shape[0], 0.5 * diameter * lam ** (-poisson))
 
 
 def open_knot_measures_dict(gaps: np.ndarray, S: np.ndarray, d0: float) -> dict[str, Any]:

@@ -26,9 +26,14 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   law (:class:`~tightknot.contact.law.RadialComplianceLaw`, or the ``law`` given):
   sections flatten and thin with stretch. Neglects friction, the coupling between the
   squeezes of neighbouring contacts on one section (each pair follows the single-pair
-  fit) and any deformation beyond the calibrated range (overlap 0.3 D); and the section
-  thins with its edge's own stretch, so a crossing pulls the edges under it apart (the FEM
-  cross-check's indent force is 11 to 16 % short, docs/fem_crosscheck.md).
+  fit) and any deformation beyond the calibrated range (overlap 0.3 D). Every section of
+  a rod thins with the rod's mean stretch L/L0 (:mod:`tightknot.contact.rod_mean_radius`;
+  with its edge's own stretch a crossing pulled the edges under it apart, 3.4 times the
+  FEM's axial force, and a knot pulled hard collapsed: docs/design_notes.md, contact);
+  neglects where along the rod a squeezed section extends: the contact's pull toward
+  thinner sections acts on the whole rod, so the tails' stretch exceeds the pull's (their
+  elastic tension 12 to 15 % above it on the 185 mm knot at 2 to 20 N), while the knot's
+  shape sees the pull itself.
   ``contact="smoothed"``: the compliant law with the section thinned by the stretch
   averaged over +-:data:`SMOOTHED_RADIUS_WINDOW` D0 along the rod
   (:mod:`tightknot.contact.section_radius`): the indent force within -8 to +7 % of the
@@ -38,6 +43,13 @@ factory takes them as parameters and records them in ``KnotScene.info["model"]``
   force, reached at another Lambda_OC within its tolerance), in as many Newton iterations
   at 1.7 to 2.6 times the time (its Hessian couples whole windows of the rod;
   bench/contact_levels.py). Not in the batch (:func:`tightknot.loading.batch.tie_batch`).
+  ``contact="sectioned"`` (or its :class:`~tightknot.contact.sectioned.SectionSettings`):
+  each vertex carries its section's Fourier modes up to N (default 8) as dofs, and contact
+  is between the deformed boundaries (:mod:`tightknot.contact.sectioned`): width, pressure
+  and area come out of the state; calibrated on the FEM's squeeze (the modes' local
+  compliance), judged by its indent, wrap and crossings (docs/sectioned_level.md).
+  Neglects friction, the section's shear along the rod and the bending stiffness a
+  flattened section loses; about 2 (N - 1) dofs per vertex more to solve. Not in the batch.
   ``contact="rigid"``: the same layer with ``law.rigid_tube()``, 1000 times stiffer and a
   hard radius D0/2 that does not thin with stretch; neglects every deformation of the
   section (the ideal-knot tube); width, pressure and area are then not reported.
@@ -61,6 +73,7 @@ import numpy as np
 
 from tightknot.contact.law import RadialComplianceLaw
 from tightknot.contact.layer import ContactLayer
+from tightknot.contact.sectioned import SectionedLayer, SectionSettings
 from tightknot.knots import curves
 from tightknot.knots.catalogue import IDEAL_L_OVER_D as IDEAL_L_OVER_D  # the scenes' name
 from tightknot.knots.catalogue import builtin, ideal_l_over_d, open_curve
@@ -79,7 +92,7 @@ STUDY_MATERIAL = Material(youngs_modulus=1.25e6, poisson_ratio=0.5, density=1160
 _CUT_OFFSET = 0.6
 
 #: Contact levels of a scene (module docstring says what each neglects).
-CONTACT_LEVELS = ("compliant", "smoothed", "rigid", "off")
+CONTACT_LEVELS = ("compliant", "smoothed", "sectioned", "rigid", "off")
 
 #: Half-width [D0] of the stretch window of the "smoothed" contact level: 1 D0 gives the
 #: FEM's axial force at the indent's deepest level (1.07 times it; 0.5 D0: 2 times), see
@@ -219,8 +232,25 @@ def _check_edge_length(pts: np.ndarray, closed: bool, d0: float, nodes: int,
                          f"are {e.max() / d0:.3g} D0 long, above pi/4 D0), got {nodes!r}")
 
 
-def check_contact(contact: str, law: RadialComplianceLaw | None = None) -> str:
-    """The ``contact`` model level, checked against :data:`CONTACT_LEVELS` and ``law``."""
+def contact_name(contact: str | SectionSettings) -> str:
+    """The level's name ("sectioned" for a sectioned level's settings)."""
+    return "sectioned" if isinstance(contact, SectionSettings) else contact
+
+
+def check_contact(contact: str | SectionSettings, law: RadialComplianceLaw | None = None
+                  ) -> str | SectionSettings:
+    """The ``contact`` model level, checked against :data:`CONTACT_LEVELS` and ``law`` (the
+    settings of a sectioned level stand for "sectioned" and are returned as they are)."""
+    if isinstance(contact, SectionSettings):
+        if law is not None:
+            raise ValueError("contact='sectioned' takes no radial-compliance law: its contact "
+                             "is calibrated by the section's FEM calibration "
+                             "(tightknot/data/section_calibration.json)")
+        return contact
+    if contact == "sectioned" and law is not None:
+        raise ValueError("contact='sectioned' takes no radial-compliance law: its contact is "
+                         "calibrated by the section's FEM calibration "
+                         "(tightknot/data/section_calibration.json)")
     if contact not in CONTACT_LEVELS:
         raise ValueError(f"contact must be one of {', '.join(CONTACT_LEVELS)}, got {contact!r}")
     if contact == "off" and law is not None:
@@ -230,12 +260,15 @@ def check_contact(contact: str, law: RadialComplianceLaw | None = None) -> str:
     return contact
 
 
-def contact_layer(model: Model, contact: str = "compliant",
+def contact_layer(model: Model, contact: str | SectionSettings = "compliant",
                   law: RadialComplianceLaw | None = None) -> ContactLayer | None:
-    """The contact layer of a model at the level ``contact`` (one of :data:`CONTACT_LEVELS`;
-    what each neglects: module docstring). ``law``: the compliant law (default the shipped
-    FEM calibration); "rigid" makes its rigid-tube version; "off" takes no law."""
+    """The contact layer of a model at the level ``contact`` (one of :data:`CONTACT_LEVELS`,
+    or the :class:`~tightknot.contact.sectioned.SectionSettings` of a sectioned level; what
+    each neglects: module docstring). ``law``: the compliant law (default the shipped FEM
+    calibration); "rigid" makes its rigid-tube version; "off" and "sectioned" take none."""
     check_contact(contact, law)
+    if contact_name(contact) == "sectioned":
+        return SectionedLayer(model, contact if isinstance(contact, SectionSettings) else None)
     if contact == "off":
         return None
     if contact == "rigid":
@@ -243,7 +276,7 @@ def contact_layer(model: Model, contact: str = "compliant",
         return ContactLayer(model, base if base.rigid else base.rigid_tube())
     if contact == "smoothed":
         return ContactLayer(model, law, radius_window=SMOOTHED_RADIUS_WINDOW)
-    return ContactLayer(model, law)
+    return ContactLayer(model, law, thinning="rod")
 
 
 def _closed_knot(name: str, knot_type: str, curve: np.ndarray, ratio: float, d0: float,
@@ -267,7 +300,8 @@ def _closed_knot(name: str, knot_type: str, curve: np.ndarray, ratio: float, d0:
     layer = contact_layer(model, contact, law)
     return KnotScene(name, model, state, layer, d0, ratio * d0, True, grow, None,
                      knot_type=knot_type,
-                     info={"l0_over_d0": ratio, "model": {"twist": twist, "contact": contact}})
+                     info={"l0_over_d0": ratio,
+                           "model": {"twist": twist, "contact": contact_name(contact)}})
 
 
 def _check_ratio(l0_over_d0: float, knot_type: str) -> float:
@@ -416,7 +450,7 @@ def _open_knot(name: str, knot_type: str, curve_fn, rest_length: float, diameter
                      info={"gauge_vertex": far, "tail_fraction": tail_fraction,
                            "grip_length": float(grip_length), "grip_vertices": grip,
                            "grip_twist": grip_twist,
-                           "model": {"twist": twist, "contact": contact}})
+                           "model": {"twist": twist, "contact": contact_name(contact)}})
 
 
 def open_trefoil(
@@ -670,11 +704,12 @@ def bending_force_scale(scene: KnotScene) -> float:
 
 def vertex_radii(scene: KnotScene, x: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, ...]:
     """Deformed edge radii r0 lam^-nu [m] (the rest radius for a rigid tube; lam the stretch
-    that thins the section: the edge's own, or the "smoothed" level's window mean) and
+    that thins the section: the rod's mean, the edge's own, or a window mean) and
     their vertex averages [m], for centerline ``x`` and edge rest lengths ``rest``."""
     m = scene.model
     ev = m.edge_vertex
-    if scene.contact is not None and scene.contact.radius_window > 0.0:
+    if scene.contact is not None and (scene.contact.radius_window > 0.0
+                                      or scene.contact.thinning == "rod"):
         lam = scene.contact.section_stretch(x, rest)
     else:
         lam = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1) / rest

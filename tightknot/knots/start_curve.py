@@ -48,6 +48,7 @@ from tightknot.knots.scenes import (
     check_contact,
     check_twist,
     contact_layer,
+    contact_name,
     rotate_to_axes,
 )
 from tightknot.rods.builder import RodBuilder
@@ -269,7 +270,7 @@ def closed_from_curve(curve: StartCurve, knot_type: str, l0_over_d0: float,
                       contact_layer(model, contact, law), d0, ratio * d0, True, start_ratio,
                       None, knot_type=knot_type,
                       info={"l0_over_d0": ratio, "start": start_info(curve, start_ratio, d0),
-                            "model": {"twist": twist, "contact": contact}})
+                            "model": {"twist": twist, "contact": contact_name(contact)}})
     scene.rebuild = lambda k: closed_from_curve(curve, knot_type, l0_over_d0, diameter, k,
                                                 material, law, twist, device, contact)
     return scene
@@ -318,7 +319,7 @@ def open_from_curve(curve: StartCurve, knot_type: str, rest_length: float, diame
                       info={"gauge_vertex": far, "grip_length": float(grip_length),
                             "grip_vertices": grip, "grip_twist": grip_twist,
                             "start": start_info(held, start_ratio, d0),
-                            "model": {"twist": twist, "contact": contact}})
+                            "model": {"twist": twist, "contact": contact_name(contact)}})
     scene.rebuild = lambda k: open_from_curve(curve, knot_type, rest_length, diameter, k,
                                               material, law, twist, device, contact,
                                               grip_length, grip_twist)

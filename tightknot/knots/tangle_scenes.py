@@ -24,7 +24,13 @@ import numpy as np
 from tightknot.contact.law import RadialComplianceLaw
 from tightknot.contact.layer import ContactLayer
 from tightknot.knots import curves, tangles
-from tightknot.knots.scenes import STUDY_DIAMETER, STUDY_MATERIAL, check_contact, contact_layer
+from tightknot.knots.scenes import (
+    STUDY_DIAMETER,
+    STUDY_MATERIAL,
+    check_contact,
+    contact_layer,
+    contact_name,
+)
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, check_positive
 from tightknot.rods.model import Model
@@ -195,6 +201,6 @@ def tangle_scene(
                         "them is calibrated on two identical rods (the pair takes the "
                         "harmonic-mean modulus and its own radii)")
     return TangleScene(kind, model, state, layer, (d_a, d_b), directions, start_type,
-                       info={"nodes": int(nodes), "contact": contact,
+                       info={"nodes": int(nodes), "contact": contact_name(contact),
                              "geometry": (geometry or tangles.TangleGeometry()).__dict__,
                              "warnings": warnings})

@@ -173,6 +173,9 @@ def build_batch(scenes: list[KnotScene]) -> BatchModel:
                              "layer")
         if len(sc.model.rods) != 1:
             raise ValueError(f"scenes[{k}] has {len(sc.model.rods)} rods; one rod per scene")
+        if sc.contact.dof_count:
+            raise ValueError(f"scenes[{k}] has contact='sectioned': the batch's banded systems "
+                             "cannot hold its section dofs; tie it on its own")
     first = scenes[0]
     twist, device = first.model.twist, first.model.device
     law = first.contact.law

@@ -426,9 +426,7 @@ class LevelPath:
 
     def _free_dofs(self, x: np.ndarray) -> np.ndarray:
         """The free dofs of the current state with positions ``x`` [m]."""
-        q = self.system.full_dofs()
-        q[self.system.model.position_dofs] = x
-        return q[self.system.pattern.free_dofs]
+        return self.system.free_vector_at(x)
 
     # -- the search ------------------------------------------------------------------------
     def seek(self, target: float, measure: Measure, search: SearchOptions) -> Coroutine[str]:

@@ -143,5 +143,12 @@ def recentre_system(scene: KnotScene, system: RodSystem
     # (every caller slides an accepted state, whose type is the scene's)
     if topology.curve_knot_type(y, scene.closed) != scene.knot_type:
         return 0, None
+    old = system.state
     system.state = State.initial(scene.model, positions=y)
+    if old.extra.size:
+        # The sectioned level's sections slide and turn with the material.
+        turn_matrix = np.array([[1.0, 0.0, 0.0], [0.0, c, -s_], [0.0, s_, c]])
+        system.state.extra = system.dof_term.slid_sections(
+            old.extra, (old.t_ref, old.d1_ref), (system.state.t_ref, system.state.d1_ref), k,
+            turn_matrix)
     return k, transform

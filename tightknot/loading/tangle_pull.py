@@ -103,7 +103,7 @@ def end_reactions(scene: TangleScene, system: RodSystem) -> list[EndReaction]:
                                      True, None)
     g = grad[system.model.position_dofs].copy()
     for term in system.extra_terms:
-        _, gk, _ = term.evaluate(x, system.rest, True, False)
+        gk = system.term_gradient(term)
         g += gk
     out = []
     for r, end, v in scene.end_vertices():

@@ -302,6 +302,6 @@ def end_reaction(system: RodSystem) -> float:
                                      True, None)
     g = grad[model.position_dofs][-1].copy()
     for term in system.extra_terms:
-        _, gk, _ = term.evaluate(x, system.rest, True, False)
+        gk = system.term_gradient(term)
         g += gk[-1]
     return float(g[0])

@@ -7,7 +7,7 @@ accepted state (Bergou 2010 sec. 4.1), and the reference twist is tracked contin
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -29,6 +29,9 @@ class State:
         v: vertex velocities [m/s], (vertex_count, 3).
         theta_dot: twist rates [rad/s], (edge_count,).
         time: simulated time [s] (dynamics only).
+        extra: the degrees of freedom an energy term owns beyond the model's (the sectioned
+            contact level's section coefficients [m]; :attr:`tightknot.rods.term.
+            EnergyTerm.dof_count`), empty without such a term.
     """
 
     x: np.ndarray
@@ -39,6 +42,7 @@ class State:
     v: np.ndarray
     theta_dot: np.ndarray
     time: float = 0.0
+    extra: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
     def initial(cls, model: Model, positions: np.ndarray | None = None) -> State:
@@ -82,6 +86,7 @@ class State:
         return State(
             self.x.copy(), self.theta.copy(), self.d1_ref.copy(), self.t_ref.copy(),
             self.m_ref.copy(), self.v.copy(), self.theta_dot.copy(), self.time,
+            self.extra.copy(),
         )
 
     def dofs(self, model: Model) -> np.ndarray:

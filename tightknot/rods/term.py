@@ -7,10 +7,16 @@ below, which are all the system calls. A term either returns its Hessian as COO 
 system's CSC data through the block tables of the system's pattern
 (:meth:`EnergyTerm.evaluate_into`); then the system asks which blocks were missing and grows
 its pattern, and between load steps asks which blocks still interact and compacts it.
+
+A term may own degrees of freedom beyond the model's (``dof_count`` > 0: the sectioned contact
+level's section coefficients). The state keeps their values (``State.extra``), the system
+appends them to its free dofs, and the term is evaluated by :meth:`EnergyTerm.
+evaluate_with_dofs`, with the state's accepted frames.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -18,6 +24,23 @@ import warp as wp
 
 #: COO triplets (rows, cols, values) over global dofs.
 Coo = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+@dataclass
+class BlockHessian:
+    """A term's Hessian as dense blocks between nodes (a node: a vertex with its b dofs,
+    e.g. its 3 coordinates and its section coefficients).
+
+    Attributes:
+        node_dofs: the extended dofs of each node (model dofs, then ``model.dof_count + j``
+            for a term's own dof j; -1 where a node has none), (nodes, b) int64.
+        keys: the node pairs (row node, column node) of the blocks, (U, 2) int64, unique.
+        blocks: the blocks, (U, b, b) [J per unit of the two dofs].
+    """
+
+    node_dofs: np.ndarray
+    keys: np.ndarray
+    blocks: np.ndarray
 
 
 class EnergyTerm(Protocol):
@@ -32,6 +55,26 @@ class EnergyTerm(Protocol):
     #: the system then checks every accepted state independently
     #: (:class:`tightknot.rods.proximity.ProximityCheck`).
     keeps_apart: bool = False
+    #: Degrees of freedom the term owns beyond the model's, kept in ``State.extra`` and
+    #: appended to the system's free dofs (0: none).
+    dof_count: int = 0
+
+    def initial_dofs(self) -> np.ndarray:
+        """The values of the term's own dofs in a new state (length ``dof_count``)."""
+        return np.zeros(self.dof_count)
+
+    def evaluate_with_dofs(self, x: np.ndarray, extra: np.ndarray,
+                           frames: tuple[np.ndarray, np.ndarray, np.ndarray],
+                           rest: np.ndarray, want_grad: bool, want_hess: bool
+                           ) -> tuple[float, np.ndarray | None, np.ndarray | None,
+                                      BlockHessian | None]:
+        """For a term with dofs of its own: the energy [J] at positions ``x`` [m] (V, 3),
+        its own dofs ``extra`` and edge rest lengths ``rest`` [m], with the state's accepted
+        frames ``frames`` = (t_ref, d1_ref, m_ref) (unit tangents and reference directors
+        per edge, reference twist per joint [rad]); its gradient over the positions (V, 3)
+        [N] and over its dofs (dof_count,), and its Hessian in node blocks over the extended
+        dofs (:class:`BlockHessian`; None where not asked)."""
+        raise NotImplementedError(f"{type(self).__name__} owns no dofs")
 
     def begin_load_step(self, x: np.ndarray, rest: np.ndarray) -> None:
         """The system moved to a new load step: positions ``x`` [m] and edge rest lengths

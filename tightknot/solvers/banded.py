@@ -126,19 +126,23 @@ class BandedCholesky:
         return None, s * x
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """Solve A x = b."""
+        """Solve A x = b for a vector b, or A X = B column by column for a matrix B."""
         p = self._plan.perm
-        y = sla.cho_solve_banded((self._c, False), (self._s * b)[p], check_finite=False)
+        sc = self._s if np.ndim(b) == 1 else self._s[:, None]
+        y = sla.cho_solve_banded((self._c, False), (sc * b)[p], check_finite=False)
         x = np.empty_like(y)
         x[p] = y
-        return self._s * x
+        return sc * x
 
 
 def banded_lu_solve(plan: BandPlan, data: np.ndarray, b: np.ndarray) -> np.ndarray | None:
-    """Solve A x = b for the matrix with entries ``data`` on ``plan``'s pattern by banded
-    LU with partial pivoting (LAPACK ``dgbsv``; for an indefinite matrix, where the
-    Cholesky factorization fails); None when A is exactly singular."""
+    """Solve A x = b (b a vector, or a matrix of right-hand sides) for the matrix with
+    entries ``data`` on ``plan``'s pattern by banded LU with partial pivoting (LAPACK
+    ``dgbsv``; for an indefinite matrix, where the Cholesky factorization fails); None when
+    A is exactly singular."""
     s, scaled = _equilibration(plan, data)
+    if np.ndim(b) == 2:
+        s = s[:, None]
     n, bw = plan.n, plan.bandwidth
     # dgbsv's band storage: kl extra rows on top for the fill of the pivoting, then
     # ab[kl + ku + i - j, j] = a[i, j] (kl = ku = bw).

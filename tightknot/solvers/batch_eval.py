@@ -107,16 +107,26 @@ class BatchContactLayer(ContactLayer):
     broad_phase_class = BatchBroadPhase
 
     def pair_terms(self, x: np.ndarray, rest: np.ndarray, rods: np.ndarray,
-                   tables: tuple[wp.array, ...], csc: wp.array, again: bool = False
+                   tables: tuple[wp.array, ...], csc: wp.array, again: bool = False,
+                   geo: dict[str, np.ndarray] | None = None
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, wp.array, int]:
         """Candidate pairs (P, 2) of the rods in mask ``rods``, their energies [J] and
         overlaps [m] (P,), the gradient over vertex positions (Warp, (V, 3)) [N] and the
         count of Hessian blocks missing from ``tables`` (the Hessian is added into
         ``csc``). ``again``: the same positions as the last call, whose candidate pairs
-        are reused (no new detection)."""
+        are reused (no new detection). ``geo``: the given contact radii of a rod-mean
+        thinning (:meth:`mean_geometry`; then the pairs' radius derivatives are in the
+        kernel's :meth:`~tightknot.contact.pair_kernel.PairKernel.radius_derivatives`)."""
+        radius = None if geo is None else self.energy._in_radius.put(geo["rho"])
         with self.broad_phase.only(rods, reuse=again, store=not again):
-            out = self.energy.launch(x, rest, True, Hessian.CSC, tables, csc)
+            out = self.energy.launch(x, rest, True, Hessian.CSC, tables, csc, radius)
         return self.last_pairs, out.energy, out.overlap, out.grad, int(out.missing.numpy()[0])
+
+    def mean_geometry(self, x: np.ndarray, rest: np.ndarray) -> dict[str, np.ndarray] | None:
+        """The radii of a rod-mean thinning at positions ``x`` [m] and rest lengths
+        ``rest`` [m] (:meth:`RodMeanRadius.radii`), None for an edge's own stretch."""
+        mean = self.energy.mean
+        return None if mean is None else mean.radii(x, rest)
 
     def step_bounds(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray,
                     rods: np.ndarray) -> np.ndarray:
@@ -212,8 +222,9 @@ class HessianData:
 
 @dataclass
 class EvalAnswer:
-    """Energy parts [J], gradient over the rod's own dofs [N, N m], Hessian, and the
-    frames carried to the trial point."""
+    """Energy parts [J], gradient over the rod's own dofs [N, N m], Hessian, the frames
+    carried to the trial point, and the contact's low-rank Hessian update (U over the rod's
+    free dofs, C) of a rod-mean thinning (None without one, or without contact)."""
 
     stretch: float
     bend: float
@@ -224,6 +235,7 @@ class EvalAnswer:
     d1: np.ndarray
     t: np.ndarray
     m_ref: np.ndarray
+    low_rank: tuple[np.ndarray, np.ndarray] | None = None
 
 
 @dataclass
@@ -316,6 +328,7 @@ class BatchEvaluator:
             off += r.pattern.nnz
         self._wjslot = wp.array(jslot, dtype=wp.int32, device=dev)
         self._weslot = wp.array(eslot, dtype=wp.int32, device=dev)
+        self._eslot = eslot
         self._edata = wp.zeros(max(off, 1), dtype=wp.float64, device=dev)
         self._tables = None
         self._cdata = None
@@ -471,8 +484,13 @@ class BatchEvaluator:
                           int(m.twist), wx, wth, wmr, wrest, self._wjslot, 1, 1],
                   outputs=[self._e_bend, self._e_twist, self._grad, self._edata])
         self._cdata.zero_()
+        geo = self.layer.mean_geometry(self.x, self.rest)
         pairs, e_pair, overlap, cgrad, missing = self.layer.pair_terms(
-            self.x, self.rest, asking, self._tables, self._cdata)
+            self.x, self.rest, asking, self._tables, self._cdata, geo=geo)
+        # A rod-mean radius: the pairs' radius derivatives of this first run (a re-run
+        # below covers some rods only).
+        d_r = (None if geo is None else
+               self.layer.energy.kernel.radius_derivatives(len(pairs)).copy())
         redo = asking
         gp, ge, go = pairs, e_pair, overlap  # what the growth looks at
         while missing:
@@ -492,7 +510,7 @@ class BatchEvaluator:
             self.contact_reruns += 1
             gp, ge, go, _, missing = self.layer.pair_terms(self.x, self.rest, redo,
                                                             self._tables, self._cdata,
-                                                            again=True)
+                                                            again=True, geo=geo)
         n_rods = len(self.rods)
         rods_e = m.edge_rod[pairs[:, 0]] if len(pairs) else np.zeros(0, dtype=np.int64)
         e_contact = np.bincount(rods_e, weights=e_pair, minlength=n_rods)
@@ -510,6 +528,9 @@ class BatchEvaluator:
         grad[m.position_dofs] += cgrad.numpy()
         cdata = self._cdata.numpy()
         edata = self._edata.numpy()
+        low: dict[int, tuple[np.ndarray, np.ndarray] | None] = {}
+        if geo is not None:
+            low = self._mean_terms(geo, pairs, e_pair, d_r, grad, edata, requests)
         out = {}
         for q in requests:
             k = q.rod
@@ -524,7 +545,39 @@ class BatchEvaluator:
             out[k] = EvalAnswer(float(e_s[k]), float(e_b[k]), float(e_t[k]),
                                 float(e_contact[k]), grad[r.dof0 : r.dof0 + r.ndof], h,
                                 d1[r.e0 : r.e0 + r.ne], tt[r.e0 : r.e0 + r.ne],
-                                mref[r.j0 : r.j0 + r.nj])
+                                mref[r.j0 : r.j0 + r.nj], low.get(k))
+        return out
+
+    def _mean_terms(self, geo: dict[str, np.ndarray], pairs: np.ndarray, e_pair: np.ndarray,
+                    d_r: np.ndarray, grad: np.ndarray, edata: np.ndarray,
+                    requests: list[EvalRequest]
+                    ) -> dict[int, tuple[np.ndarray, np.ndarray] | None]:
+        """The chain rule of a rod-mean contact radius (as
+        :meth:`tightknot.contact.energy.ContactEnergy.evaluate_into`): its gradient term
+        added into ``grad`` (all dofs), its stretch blocks into the elastic Hessian data
+        ``edata`` (through the edges' slots), and each asking rod's low-rank update over
+        its free dofs."""
+        m = self.model
+        energy = self.layer.energy
+        mean = energy.mean
+        active = np.flatnonzero(e_pair != 0.0)
+        pr = pairs[active].astype(np.int64)
+        dr = d_r[active]
+        g, big_g = mean.gradient(geo, pr, dr[:, 0])
+        grad[m.position_dofs] += g
+        blk = mean.stretch_blocks(geo, big_g).reshape(m.edge_count, 36)
+        slot = self._eslot
+        ok = slot >= 0
+        np.add.at(edata, slot[ok], blk[ok])
+        out: dict[int, tuple[np.ndarray, np.ndarray] | None] = {}
+        rod_of = m.edge_rod[pr[:, 0]] if len(pr) else np.zeros(0, dtype=np.int64)
+        for q in requests:
+            k = q.rod
+            mine = rod_of == k
+            r = self.rods[k]
+            lr = mean.low_rank(geo, pr[mine], energy.pair_dofs(pr[mine]), dr[mine, 0],
+                               dr[mine, 1], dr[mine, 2:], dofs=(r.dof0, r.dof0 + r.ndof))
+            out[k] = None if lr is None else (lr[0][r.pattern.free_dofs], lr[1])
         return out
 
     def max_step(self, requests: list[StepRequest]) -> dict[int, float]:

@@ -43,8 +43,9 @@ class Factorization:
                              options=dict(SymmetricMode=True))
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """Solve A x = b."""
-        return self._s * self._lu.solve(self._s * b)
+        """Solve A x = b for a vector b, or A X = B column by column for a matrix B."""
+        s = self._s if np.ndim(b) == 1 else self._s[:, None]
+        return s * self._lu.solve(s * b)
 
 
 def factorize(a: sp.spmatrix) -> Factorization:
@@ -52,28 +53,99 @@ def factorize(a: sp.spmatrix) -> Factorization:
     return Factorization(a)
 
 
+class LowRankHessian:
+    """A Hessian ``H = B + U C U^T``: a sparse part ``base`` (what the linear solver
+    factors) and a dense update of low rank (a contact radius thinned by a rod's mean
+    stretch couples every vertex of the rod: :mod:`tightknot.contact.rod_mean_radius`).
+
+    Args:
+        base: the sparse part (a CSC matrix, or a batch rod's Hessian data).
+        u: (n, m) [units of the dofs' gradients per unit s] columns of the update.
+        c: (m, m) symmetric core of the update.
+    """
+
+    def __init__(self, base: object, u: np.ndarray, c: np.ndarray) -> None:
+        self.base = base
+        self.u = np.ascontiguousarray(u, dtype=np.float64)
+        self.c = np.ascontiguousarray(c, dtype=np.float64)
+
+    def toarray(self) -> np.ndarray:
+        """The whole Hessian as a dense array (tests, diagnostics)."""
+        base = self.base.toarray() if hasattr(self.base, "toarray") else (
+            self.base.matrix().toarray())
+        return base + self.u @ self.c @ self.u.T
+
+    def diagonal_update(self) -> np.ndarray:
+        """The update's diagonal, rows of (U C) . U."""
+        return np.einsum("ij,ij->i", self.u @ self.c, self.u)
+
+    def product(self, matrix: object) -> LowRankProduct:
+        """The operator ``d -> matrix @ d + U C U^T d`` for the base's ``matrix``."""
+        return LowRankProduct(matrix, self.u, self.c)
+
+
+class LowRankProduct:
+    """Products with ``A + U C U^T`` (A a sparse matrix): ``op @ d``."""
+
+    def __init__(self, a: object, u: np.ndarray, c: np.ndarray) -> None:
+        self.a, self.u, self.c = a, u, c
+
+    def __matmul__(self, d: np.ndarray) -> np.ndarray:
+        return self.a @ d + self.u @ (self.c @ (self.u.T @ d))
+
+
+def woodbury_solve(solve: object, u: np.ndarray, c: np.ndarray, b: np.ndarray
+                   ) -> np.ndarray | None:
+    """Solve ``(A + U C U^T) x = b`` given ``solve``, the solution of ``A X = B`` for a
+    vector or a matrix B, by the Woodbury identity (Golub & Van Loan 2013, sec. 2.1.4):
+    ``x = y - Z (C^-1 + U^T Z)^-1 U^T y`` with ``y = A^-1 b``, ``Z = A^-1 U``, written
+    without C^-1 as ``x = y - Z C (I + U^T Z C)^-1 U^T y`` (C may be singular). None when
+    the small system is singular or the result not finite."""
+    y = solve(b)
+    z = solve(u)
+    if z.ndim == 1:
+        z = z[:, None]
+    small = np.eye(c.shape[0]) + (u.T @ z) @ c
+    try:
+        v = np.linalg.solve(small, u.T @ y)
+    except np.linalg.LinAlgError:
+        return None
+    x = y - z @ (c @ v)
+    return x if np.isfinite(x).all() else None
+
+
 class SparseDirect:
     """The Newton loop's linear algebra for a Hessian held as a scipy CSC matrix: shifted
     systems ``(H + mu D) d = -g`` solved by :func:`factorize` (SuperLU)."""
 
     @staticmethod
-    def matrix(h: sp.csc_matrix) -> sp.csc_matrix:
-        """The Hessian as a sparse matrix (for products)."""
+    def matrix(h: sp.csc_matrix | LowRankHessian) -> object:
+        """The Hessian as an operator for products (a sparse matrix, or with a low-rank
+        update :class:`LowRankProduct`)."""
+        if isinstance(h, LowRankHessian):
+            return h.product(h.base)
         return h
 
     @staticmethod
-    def diagonal(h: sp.csc_matrix) -> np.ndarray:
+    def diagonal(h: sp.csc_matrix | LowRankHessian) -> np.ndarray:
         """The Hessian's diagonal."""
+        if isinstance(h, LowRankHessian):
+            return h.base.diagonal() + h.diagonal_update()
         return h.diagonal()
 
     @staticmethod
-    def shifted_direction(h: sp.csc_matrix, g: np.ndarray, mu: float,
+    def shifted_direction(h: sp.csc_matrix | LowRankHessian, g: np.ndarray, mu: float,
                           diag: np.ndarray) -> np.ndarray | None:
         """Solve (H + mu D) d = -g with D = diag(``diag``); None when singular or not
-        finite."""
-        a = h if mu == 0.0 else (h + sp.diags(mu * diag, format="csc"))
+        finite. A low-rank update is solved by :func:`woodbury_solve` around the
+        factorization of the sparse part."""
+        base = h.base if isinstance(h, LowRankHessian) else h
+        a = base if mu == 0.0 else (base + sp.diags(mu * diag, format="csc"))
         try:
-            d = factorize(a).solve(-g)
+            fac = factorize(a)
         except RuntimeError:  # exactly singular
             return None
+        if isinstance(h, LowRankHessian):
+            return woodbury_solve(fac.solve, h.u, h.c, -g)
+        d = fac.solve(-g)
         return d if np.isfinite(d).all() else None

@@ -31,7 +31,7 @@ from tightknot.solvers.batch_eval import (
     HessianData,
     StepRequest,
 )
-from tightknot.solvers.linear import SparseDirect, factorize
+from tightknot.solvers.linear import LowRankHessian, SparseDirect, factorize, woodbury_solve
 from tightknot.solvers.program import Coroutine, Evaluate, StepBound
 from tightknot.solvers.system import RodSystem
 
@@ -69,23 +69,42 @@ class BandedSolver:
         self._certificate: tuple[HessianData, float, float] | None = None
 
     @staticmethod
-    def matrix(h: HessianData) -> Any:
-        """The Hessian as a sparse matrix (for products)."""
+    def matrix(h: HessianData | LowRankHessian) -> Any:
+        """The Hessian as an operator for products (with its low-rank update, if any)."""
+        if isinstance(h, LowRankHessian):
+            return h.product(h.base.matrix())
         return h.matrix()
 
     @staticmethod
-    def diagonal(h: HessianData) -> np.ndarray:
+    def diagonal(h: HessianData | LowRankHessian) -> np.ndarray:
         """The Hessian's diagonal."""
+        if isinstance(h, LowRankHessian):
+            return h.base.diagonal() + h.diagonal_update()
         return h.diagonal()
 
-    def shifted_direction(self, h: HessianData, g: np.ndarray, mu: float,
+    def shifted_direction(self, h: HessianData | LowRankHessian, g: np.ndarray, mu: float,
                           diag: np.ndarray) -> np.ndarray | None:
-        """Solve (H + mu D) d = -g (as :class:`tightknot.solvers.linear.SparseDirect`)."""
+        """Solve (H + mu D) d = -g (as :class:`tightknot.solvers.linear.SparseDirect`; a
+        low-rank update by :func:`tightknot.solvers.linear.woodbury_solve` around the
+        factorization of the band)."""
         t0 = time.perf_counter()
         try:
+            if isinstance(h, LowRankHessian):
+                return self._woodbury(h, g, mu, diag)
             return self._solve(h, g, mu, diag)
         finally:
             self.stats.seconds += time.perf_counter() - t0
+
+    def _woodbury(self, h: LowRankHessian, g: np.ndarray, mu: float,
+                  diag: np.ndarray) -> np.ndarray | None:
+        """The solve of a low-rank update: the band's solver on the right-hand side and on
+        the update's columns together (one factorization)."""
+        rhs = np.column_stack([-g, h.u])
+        sol = self._solve(h.base, -rhs, mu, diag)
+        if sol is None:
+            return None
+        y, z = sol[:, 0], sol[:, 1:]
+        return woodbury_solve(lambda b: y if b.ndim == 1 else z, h.u, h.c, -g)
 
     def _solve(self, h: HessianData, g: np.ndarray, mu: float,
                diag: np.ndarray) -> np.ndarray | None:

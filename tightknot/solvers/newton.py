@@ -14,7 +14,10 @@ Convergence: the scaled residual (forces over EI/L^2, moments over EI/L) is belo
 failure instead of spending the iteration budget: tiny steps without a small residual
 ("stagnated"), and no progress over a window of iterations, i.e. neither the best residual
 nor the energy improved by a measurable amount ("stalled": a solver cycling at a point it
-cannot pass). A failed solve returns a result saying so, never NaN.
+cannot pass), or several iterations in a row predicted a decrease below the energy's
+round-off without lowering the residual ("stalled" too: the energy can no longer judge the
+steps, and the trust ratio, noise then, is not used to raise the shift). A failed solve
+returns a result saying so, never NaN.
 """
 
 from __future__ import annotations
@@ -54,6 +57,10 @@ class NewtonOptions:
         stall_roundoffs: energy decrease that counts as progress, in units of the
             problem's energy round-off (a thousand: well above noise, yet far below the
             decrease of any iteration that moves the rod measurably).
+        blind_iterations: the solve stops as "stalled" after this many iterations in a
+            row whose predicted decrease was below the energy's round-off (the energy can
+            then not judge the step) while the residual did not fall below
+            ``stall_factor`` times its value before them (0 turns it off).
     """
 
     residual_tol: float = 1e-8
@@ -67,6 +74,7 @@ class NewtonOptions:
     stall_iterations: int = 50
     stall_factor: float = 0.5
     stall_roundoffs: float = 1e3
+    blind_iterations: int = 10
 
     def __post_init__(self) -> None:
         for name in ("residual_tol", "step_tol", "armijo", "shift_initial", "shift_trust",
@@ -75,7 +83,7 @@ class NewtonOptions:
             if not (isinstance(v, numbers.Real) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v!r}")
         for name, low in (("max_iterations", 1), ("max_backtracks", 1),
-                          ("stall_iterations", 0)):
+                          ("stall_iterations", 0), ("blind_iterations", 0)):
             v = getattr(self, name)
             if not (isinstance(v, numbers.Integral) and v >= low):
                 raise ValueError(f"{name} must be a whole number >= {low}, got {v!r}")
@@ -133,6 +141,7 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
     # Progress record of the stall test: best residual and energy after each iteration.
     best = [res]
     energies = [energy]
+    blind, blind_ref = 0, res
     for it in range(1, opt.max_iterations + 1):
         accepted = False
         h = p.linear.matrix(hp)
@@ -194,7 +203,10 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
         # Levenberg-Marquardt step): a step that had to be cut, or whose actual decrease is
         # a small part of the quadratic model's, means the model is trusted too far: damp
         # more; a full step that the model predicted well lets the shift decay to zero.
-        ratio = (e_old - energy) / predicted if predicted > 0 else 1.0
+        # Below the energy's round-off the actual decrease is noise: the ratio then says
+        # nothing about the model, and must not raise the shift (it did, without end).
+        unjudged = predicted <= roundoff
+        ratio = (e_old - energy) / predicted if predicted > 0 and not unjudged else 1.0
         if alpha < 0.5 or ratio < 0.25:
             mu = max(4.0 * mu, opt.shift_trust)
         elif alpha == 1.0 and ratio > 0.75:
@@ -205,9 +217,15 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
         # stiff inertia of a short time step) is progress; one that did not is stagnation.
         if step <= opt.step_tol and res > opt.stall_factor * history[-2]:
             return NewtonResult(False, it, res, step, energy, "stagnated", history)
+        # A run of unjudged steps that does not halve the residual (stall_factor) is blind.
+        if not unjudged or res <= opt.stall_factor * blind_ref:
+            blind, blind_ref = 0, res
+        else:
+            blind += 1
         best.append(min(best[-1], res))
         energies.append(energy)
-        if _stalled(best, energies, opt, p.energy_roundoff()):
+        if _stalled(best, energies, opt, p.energy_roundoff()) or (
+                opt.blind_iterations and blind >= opt.blind_iterations):
             return NewtonResult(False, it, res, step, energy, "stalled", history)
     return NewtonResult(False, opt.max_iterations, res, step, energy, "max_iterations", history)
 

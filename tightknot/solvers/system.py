@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import warp as wp
 
@@ -25,8 +26,8 @@ from tightknot.rods.model import Model
 from tightknot.rods.proximity import ProximityCheck
 from tightknot.rods.staging import Output
 from tightknot.rods.state import State
-from tightknot.rods.term import EnergyTerm
-from tightknot.solvers.linear import SparseDirect
+from tightknot.rods.term import BlockHessian, EnergyTerm
+from tightknot.solvers.linear import LowRankHessian, SparseDirect
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
 
@@ -93,6 +94,9 @@ class RodSystem:
         self.bcs = bcs if bcs is not None else BoundaryConditions(model)
         self.gravity = None if gravity is None else np.asarray(gravity, dtype=np.float64)
         self.extra_terms: list[EnergyTerm] = []
+        #: The term that owns dofs beyond the model's (State.extra), or None.
+        self.dof_term: EnergyTerm | None = None
+        self._own_pattern: dict | None = None
         self.inertia: Inertia | None = None
         self.pattern = SparsePattern(model, ~self.bcs.fixed_mask())
         self.forces = ElasticForces(model, self.pattern.joint_slot, self.pattern.edge_slot)
@@ -138,6 +142,12 @@ class RodSystem:
         """Add an energy term (e.g. the contact layer); it first checks the state
         (``term.check_state``: a start that already violates it is refused)."""
         term.check_state(self.state.x)
+        if term.dof_count:
+            if self.dof_term is not None:
+                raise ValueError("a rod system takes one term with dofs of its own")
+            self.dof_term = term
+            if self.state.extra.shape != (term.dof_count,):
+                self.state.extra = term.initial_dofs()
         self.extra_terms.append(term)
         term.begin_load_step(self.state.x, self.rest)
         if term.keeps_apart and self.proximity is None:
@@ -179,12 +189,24 @@ class RodSystem:
         return self.state.dofs(self.model)
 
     def free_vector(self) -> np.ndarray:
-        """The state's free dofs."""
-        return self.full_dofs()[self.pattern.free_dofs]
+        """The state's free dofs (then the dofs of a term that owns some, State.extra)."""
+        u = self.full_dofs()[self.pattern.free_dofs]
+        if self.dof_term is None:
+            return u
+        return np.concatenate([u, self.state.extra])
+
+    def free_vector_at(self, x: np.ndarray) -> np.ndarray:
+        """:meth:`free_vector` with the positions ``x`` [m] in place of the state's."""
+        q = self.full_dofs()
+        q[self.model.position_dofs] = x
+        u = q[self.pattern.free_dofs]
+        if self.dof_term is None:
+            return u
+        return np.concatenate([u, self.state.extra])
 
     def _split(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         q = self.full_dofs()
-        q[self.pattern.free_dofs] = u
+        q[self.pattern.free_dofs] = u[: self.pattern.n]
         x = q[self.model.position_dofs]
         theta = q[self.model.edge_dof] if self.model.twist else self.state.theta
         return x, theta
@@ -205,6 +227,8 @@ class RodSystem:
         x, theta = self._split(u)
         d1, tt, mref = self.forces.transport_frames(x, st.d1_ref, st.t_ref, st.m_ref)
         self._trial = (u.copy(), x, theta, d1, tt, mref)
+        n_model = self.pattern.n
+        own = None  # the dof term's (gradient over its dofs, Hessian COO)
         if want_hess:
             self._hess.zero_()
         el, grad = self.forces.evaluate(x, theta, mref, self.rest, want_grad or want_hess,
@@ -235,12 +259,25 @@ class RodSystem:
                         break
                 else:
                     break
+        low_rank = []
         for term in self.extra_terms:
+            if term is self.dof_term:
+                e_k, g_k, g_own, h_own = term.evaluate_with_dofs(
+                    x, u[n_model:], (st.t_ref, st.d1_ref, st.m_ref), self.rest,
+                    want_grad or want_hess, want_hess)
+                split.extra[term.name] = e_k
+                if grad is not None and g_k is not None:
+                    grad[m.position_dofs] += g_k
+                own = (g_own, h_own)
+                continue
             if id(term) in results:
                 # (energy, gradient) or, from a contact layer with a radius window, also the
-                # COO Hessian terms outside its pair blocks
+                # COO Hessian terms outside its pair blocks; with a rod-mean radius also a
+                # dense update (U, C) of low rank (tightknot.contact.rod_mean_radius)
                 e_k, g_k, *rest_k = results[id(term)]
                 h_k = rest_k[0] if rest_k else None
+                if len(rest_k) > 1 and rest_k[1] is not None:
+                    low_rank.append(rest_k[1])
             else:
                 e_k, g_k, h_k = term.evaluate(x, self.rest, want_grad or want_hess, want_hess)
             split.extra[term.name] = e_k
@@ -251,6 +288,8 @@ class RodSystem:
         grad = self._with_inertia(u, split, grad)
         self.last_split = split
         g_free = grad[self.pattern.free_dofs] if grad is not None else None
+        if own is not None and g_free is not None:
+            g_free = np.concatenate([g_free, own[0]])
         hmat = None
         if want_hess:
             data = self._hess.numpy()[: self.pattern.nnz].copy()
@@ -264,7 +303,22 @@ class RodSystem:
             hmat = pattern.matrix(data)
             if coo_parts:
                 hmat = hmat + self._coo_free(coo_parts)
+            if own is not None:
+                hmat = self._with_own_hessian(hmat, own[1])
+            if low_rank:
+                free = self.pattern.free_dofs
+                hmat = LowRankHessian(hmat, np.hstack([u[free] for u, _ in low_rank]),
+                                      sla.block_diag(*[c for _, c in low_rank]))
         return split.total, g_free, hmat
+
+    def term_gradient(self, term: EnergyTerm) -> np.ndarray:
+        """The gradient [N] (vertex_count, 3) over the positions of one of the system's
+        extra terms at the state (a term with dofs of its own at the state's, State.extra)."""
+        st = self.state
+        if term is self.dof_term:
+            return term.evaluate_with_dofs(st.x, st.extra, (st.t_ref, st.d1_ref, st.m_ref),
+                                           self.rest, True, False)[1]
+        return term.evaluate(st.x, self.rest, True, False)[1]
 
     def evaluated(self, u: np.ndarray, x: np.ndarray, theta: np.ndarray, answer: Any,
                   want_grad: bool, want_hess: bool) -> tuple[float, np.ndarray | None, Any]:
@@ -286,6 +340,8 @@ class RodSystem:
                 data = h.data.copy()
                 self._add_inertia_diagonal(data, h.diag_slot)
                 h = type(h)(h.indptr, h.indices, h.diag_slot, data)
+            if answer.low_rank is not None:
+                h = LowRankHessian(h, *answer.low_rank)
         return split.total, g_free, h
 
     def _with_inertia(self, u: np.ndarray, split: EnergySplit,
@@ -295,7 +351,7 @@ class RodSystem:
         if self.inertia is None:
             return grad
         q = self.full_dofs()
-        q[self.pattern.free_dofs] = u
+        q[self.pattern.free_dofs] = u[: self.pattern.n]
         dq = q - self.inertia.q_hat
         w = self.inertia.mass / self.inertia.dt**2
         split.inertia = 0.5 * float(np.sum(w * dq * dq))
@@ -311,10 +367,68 @@ class RodSystem:
     def compact_pattern(self) -> None:
         """Drop contact blocks that no longer interact (call between load steps: a pattern
         that only grows would carry stale zeros into every later factorization)."""
+        self._own_pattern = None
         if self._cpattern is None:
             return
         keys = [t.active_blocks() for t in self.extra_terms]
         self._cpattern.reset(np.concatenate(keys) if keys else np.zeros(0, np.int64))
+
+    def _with_own_hessian(self, hmat: sp.csc_matrix, own: BlockHessian) -> sp.csc_matrix:
+        """The free-dof Hessian ``hmat`` of the model's dofs grown by the dof term's dofs,
+        with that term's node blocks ``own`` added.
+
+        The union of the two patterns and each entry's slot in it are kept through a load
+        step: while ``hmat``'s pattern is the same and the blocks' node pairs are among the
+        kept ones (contacts that come and go within a step), an evaluation only places
+        values; a node pair that is new grows the kept set. A new load step starts afresh
+        (:meth:`compact_pattern`), so that pairs no longer in contact leave it."""
+        cache = self._own_pattern
+        same = (cache is not None and np.array_equal(cache["indptr"], hmat.indptr)
+                and np.array_equal(cache["indices"], hmat.indices))
+        nodes = own.node_dofs.shape[0]
+        new_keys = own.keys[:, 0] * nodes + own.keys[:, 1]
+        if same:
+            kept = cache["keys"]
+            at = np.minimum(np.searchsorted(kept, new_keys), kept.size - 1)
+            same = bool(np.all(kept[at] == new_keys))
+        if not same:
+            keys = new_keys if cache is None else np.union1d(cache["keys"], new_keys)
+            cache = self._own_union(hmat, own.node_dofs, keys)
+            at = np.searchsorted(keys, new_keys)
+        b = own.blocks.shape[1]
+        blocks = np.zeros((cache["keys"].size, b, b))
+        blocks[at] = own.blocks
+        data = np.zeros(cache["indices_u"].size)
+        data[cache["slot_e"]] = hmat.data
+        data[cache["slot_t"]] += blocks.ravel()[cache["valid"]]
+        size = cache["size"]
+        return sp.csc_matrix((data, cache["indices_u"], cache["indptr_u"]), shape=(size, size))
+
+    def _own_union(self, hmat: sp.csc_matrix, node_dofs: np.ndarray, keys: np.ndarray) -> dict:
+        """The union of ``hmat``'s pattern with the node blocks of node-pair ``keys`` (row
+        node x nodes + column node), and each entry's slot in it (kept as the cache)."""
+        n, n_own = self.pattern.n, self.dof_term.dof_count
+        nodes = node_dofs.shape[0]
+        index = np.concatenate([self.pattern.free_index, n + np.arange(n_own)])
+        node_free = np.where(node_dofs >= 0, index[node_dofs], -1)
+        b = node_free.shape[1]
+        shape = (keys.size, b, b)
+        rows = np.broadcast_to(node_free[keys // nodes][:, :, None], shape)
+        cols = np.broadcast_to(node_free[keys % nodes][:, None, :], shape)
+        valid = ((rows >= 0) & (cols >= 0)).ravel()
+        size = n + n_own
+        e_cols = np.repeat(np.arange(n), np.diff(hmat.indptr))
+        all_r = np.concatenate([hmat.indices, rows.ravel()[valid]]).astype(np.int64)
+        all_c = np.concatenate([e_cols, cols.ravel()[valid]]).astype(np.int64)
+        union = sp.csc_matrix((np.ones(all_r.size), (all_r, all_c)), shape=(size, size))
+        union.sum_duplicates()
+        u_cols = np.repeat(np.arange(size, dtype=np.int64), np.diff(union.indptr))
+        slots = np.searchsorted(u_cols * size + union.indices, all_c * size + all_r)
+        cache = {"keys": keys, "indptr": hmat.indptr.copy(), "indices": hmat.indices.copy(),
+                 "valid": valid, "slot_e": slots[:hmat.nnz], "slot_t": slots[hmat.nnz:],
+                 "indptr_u": union.indptr, "indices_u": union.indices, "size": size}
+        self._own_pattern = cache
+        return cache
 
     def _coo_free(self, parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> sp.csc_matrix:
         fi = self.pattern.free_index
@@ -345,6 +459,8 @@ class RodSystem:
         _, x, theta, d1, tt, mref = self._trial
         st = self.state
         st.x, st.d1_ref, st.t_ref, st.m_ref = x.copy(), d1, tt, mref
+        if self.dof_term is not None:
+            st.extra = np.array(u[self.pattern.n:], dtype=np.float64)
         if self.model.twist:
             st.theta = theta.copy()
         if self.history is not None:
@@ -381,12 +497,20 @@ class RodSystem:
         """Max-norm of the free-dof gradient, forces over EI/L^2 and moments over EI/L [-]."""
         if g.size == 0:
             return 0.0
-        scale = np.where(self.free_is_theta, self.moment_scale, self.force_scale)
+        # A dof term's generalised forces (energy per coefficient length) are forces.
+        scale = np.where(self._is_theta(g.size), self.moment_scale, self.force_scale)
         return float(np.max(np.abs(g) / scale))
 
     def step_norm(self, du: np.ndarray) -> float:
         """Max-norm of a step, displacements over the smallest radius, angles in rad [-]."""
         if du.size == 0:
             return 0.0
-        scale = np.where(self.free_is_theta, 1.0, self.length_scale)
+        scale = np.where(self._is_theta(du.size), 1.0, self.length_scale)
         return float(np.max(np.abs(du) / scale))
+
+    def _is_theta(self, size: int) -> np.ndarray:
+        """Which of ``size`` free dofs are twist angles (a dof term's are lengths)."""
+        if size == self.free_is_theta.size:
+            return self.free_is_theta
+        return np.concatenate([self.free_is_theta,
+                               np.zeros(size - self.free_is_theta.size, dtype=bool)])

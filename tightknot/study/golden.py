@@ -27,7 +27,7 @@ CANONICAL = {
     "open_185mm": (lambda: open_trefoil(rest_length=0.185, nodes=150),
                    {"pull_force": 1.8, "tighten_steps": 20, "pull_steps": 20}),
     "open_125mm": (lambda: open_trefoil(rest_length=0.125, nodes=100),
-                   {"pull_force": 5.67, "tighten_steps": 20, "pull_steps": 20}),
+                   {"pull_force": 7.43, "tighten_steps": 20, "pull_steps": 20}),
 }
 #: The study's Lambda_OC of the open canonical knots.
 TARGET_LAMBDA = {"open_185mm": 15.0, "open_125mm": 10.1}

@@ -38,7 +38,7 @@ KNOTS = ("closed", "open")
 KNOT_TYPES = KNOT_NAMES
 SCENE_NAMES = {t: {"3_1": "trefoil", "4_1": "figure_eight"}.get(t, t) for t in KNOT_TYPES}
 #: Contact levels that can tie a knot (tightknot.knots.scenes.CONTACT_LEVELS less "off").
-CONTACT_LEVELS = ("compliant", "smoothed", "rigid")
+CONTACT_LEVELS = ("compliant", "smoothed", "sectioned", "rigid")
 
 #: Defaults that depend on the knot, (knot, knot_type) -> {key: value} (the vertex count
 #: follows the rest length: :func:`resolve_nodes`): the scenes' own
@@ -118,8 +118,13 @@ class Scene:
     density: float = param(1160.0, Range(0.0, 1e5), "kg/m^3", "mass density", metavar="RHO")
     contact: str = param("compliant", CONTACT_LEVELS, "",
                          "contact level: compliant (the FEM-calibrated law), smoothed "
-                         "(sections thinned by the stretch averaged over +-1 D0), rigid "
-                         "(a rigid tube)")
+                         "(sections thinned by the stretch averaged over +-1 D0), sectioned "
+                         "(each section's Fourier modes as state, contact between the "
+                         "deformed boundaries), rigid (a rigid tube)")
+    section_modes: int = param(8, Range(4, 12), "",
+                               "highest Fourier mode N of each section at the sectioned "
+                               "contact level (an ellipse cannot wrap a convex partner: "
+                               ">= 4)", metavar="N")
     twist: bool | None = param(None, None, "", "twist dofs",
                                default_text=_knot_default_text("twist"))
     grip_length: float = param(1.0, Range(0.0, 1e3), "D0",
@@ -211,12 +216,17 @@ def check_scene(values: Mapping[str, Any]) -> None:
 def read_start(values: Mapping[str, Any]):
     """The start curve of a run whose ``start`` is given
     (:func:`tightknot.knots.start_curve.read_start_curve`); ValueError naming the file."""
-    from tightknot.knots.centerline_io import parse_columns
+    from tightknot.knots.centerline_io import CenterlineError, parse_columns
     from tightknot.knots.start_curve import read_start_curve
 
     columns = values.get("columns")
-    return read_start_curve(values["start"], values["knot"] == "closed", values.get("units"),
-                            None if columns is None else parse_columns(columns))
+    try:
+        return read_start_curve(values["start"], values["knot"] == "closed",
+                                values.get("units"),
+                                None if columns is None else parse_columns(columns))
+    except CenterlineError as err:
+        # the parameter's name first, as every bad-input message has it
+        raise CenterlineError(f"start: {err}") from None
 
 
 def resolve_start(values: Mapping[str, Any]) -> dict[str, Any]:
@@ -248,10 +258,13 @@ def resolve_start(values: Mapping[str, Any]) -> dict[str, Any]:
 def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     """The :class:`~tightknot.knots.scenes.KnotScene` of resolved scene parameters
     ``values`` (every :class:`Scene` field of its knot given; other keys are ignored)."""
+    from tightknot.contact.sectioned import SectionSettings
     from tightknot.knots import scenes
     from tightknot.rods.material import Material
 
     material = Material(values["youngs_modulus"], values["poisson"], values["density"])
+    contact = (SectionSettings(max_mode=values["section_modes"])
+               if values["contact"] == "sectioned" else values["contact"])
     if values.get("start") is not None:
         from tightknot.knots import start_curve
 
@@ -260,10 +273,10 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
             return start_curve.closed_from_curve(
                 curve, values["knot_type"], values["l0_over_d0"], values["diameter"],
                 values["nodes"], material, twist=values["twist"], device=device,
-                contact=values["contact"])
+                contact=contact)
         return start_curve.open_from_curve(
             curve, values["knot_type"], values["length"], values["diameter"], values["nodes"],
-            material, twist=values["twist"], device=device, contact=values["contact"],
+            material, twist=values["twist"], device=device, contact=contact,
             grip_length=values["grip_length"], grip_twist=values["grip_twist"])
     make = scenes.closed_knot if values["knot"] == "closed" else scenes.open_knot
     length = values["l0_over_d0"] if values["knot"] == "closed" else values["length"]
@@ -272,5 +285,4 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     shape = ({"start_shape": values.get("start_shape", StartFile.start_shape)}
              if values["knot"] == "closed" else {})
     return make(values["knot_type"], length, values["diameter"], values["nodes"], material,
-                twist=values["twist"],
-                contact=values["contact"], device=device, **grips, **shape)
+                twist=values["twist"], contact=contact, device=device, **grips, **shape)

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from tightknot.contact.checks import deepest_approaches
 from tightknot.contact.report import ContactReport, contact_report
 from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal_overlay import aligned, ideal_report
@@ -87,7 +88,7 @@ def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
     the tightening's end reaction and the pull's force are separate series."""
     x = system.state.x
     r_e, r_v = vertex_radii(scene, x, system.rest)
-    rep = contact_report(scene.contact, x)
+    rep = contact_report(scene.contact, x, system.rest, system.state)
     values, at = rod_field(color_by, scene, x, system.rest, rep)
     log.log_rod(f"{name}/rod", x, scene.closed, r_e, values, color_by, field_at=at,
                 radii_at="edge")
@@ -187,7 +188,7 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         "contact_sigma": np.asarray(rep["contact_sigma"]).tolist(),
         "centerline_m": x.tolist(),
     }
-    out.update(calibration_range(scene, contact))
+    out.update(calibration_range(scene, contact, x, res.system.rest))
     if scene.closed:
         # Null with the reason in "threefold" where the knot has no trefoil's 3-fold axis.
         out["rho"] = None if rep["rho"] is None else np.asarray(rep["rho"]).tolist()
@@ -226,26 +227,38 @@ def knot_title(closed: bool, knot_type: str) -> str:
     return f"{'closed' if closed else 'open'} {common.get(knot_type, f'{knot_type} knot')}"
 
 
-def calibration_range(scene: KnotScene, contact: ContactReport) -> dict[str, Any]:
+def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | None = None,
+                      rest: np.ndarray | None = None) -> dict[str, Any]:
     """Where the state stands against the range its contact law was calibrated in: the
     largest per-side approach w/D0 of its contacts (half the pair overlap), the law's
     calibrated limit, and a warning for each way the run leaves it (a deeper squeeze, whose
-    force is then extrapolated; a rod that is not incompressible, nu != 0.5, while the law
-    was calibrated on an incompressible solid)."""
+    force is then extrapolated; with the positions ``x`` [m] and rest lengths ``rest`` [m],
+    a crossing deeper than the point law's fit, whose core was fitted to line squeezes
+    only; a rod that is not incompressible, nu != 0.5, while the law was calibrated on an
+    incompressible solid)."""
     law = scene.contact.law
     w_hat = 0.5 * float(np.max(contact.overlap, initial=0.0)) / scene.diameter
     warnings = []
+    w_cross = None
+    if not law.rigid and x is not None and rest is not None:
+        w_cross = deepest_approaches(scene.contact, x, rest)[1] / scene.diameter
     if not law.rigid:
         if w_hat > law.calibrated_w_hat:
             warnings.append(f"the contact reaches a per-side approach w/D0 = {w_hat:.3g}, "
                             f"beyond the {law.calibrated_w_hat:.3g} the law was calibrated to "
                             "(its force there is extrapolated)")
+        if w_cross is not None and w_cross > law.power_w_hat:
+            warnings.append(f"a crossing reaches w/D0 = {w_cross:.3g}, beyond the "
+                            f"{law.power_w_hat:.3g} the point law was fitted to (its force "
+                            "there is extrapolated)")
         nus = {r.material.poisson_ratio for r in scene.model.rods}
         if any(abs(nu - 0.5) > 1e-12 for nu in nus):
             warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "
                             "calibrated on an incompressible solid (nu = 0.5): extrapolated")
     return {"max_approach_w_over_D0": w_hat,
             "calibrated_w_over_D0": None if law.rigid else law.calibrated_w_hat,
+            "max_crossing_w_over_D0": w_cross,
+            "crossing_calibrated_w_over_D0": None if law.rigid else law.power_w_hat,
             "outside_calibrated_range": bool(warnings), "warnings": warnings}
 
 
@@ -313,7 +326,7 @@ def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
     # centerline (segments touch between vertices) and the contact law's onset band.
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
                              radii=r_v, contact_tol=CONTACT_TOL)
-    contact = contact_report(scene.contact, x, res.system.rest)
+    contact = contact_report(scene.contact, x, res.system.rest, res.system.state)
     summary = summarise(scene, res, rep, contact)
     summary["load_steps"] = load_steps
     # What the mesh costs in accuracy, so a coarse run says so (the trade-off study's numbers);

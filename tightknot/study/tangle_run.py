@@ -68,7 +68,7 @@ def log_tangle(log: Any, scene: TangleScene, name: str, system: RodSystem,
     for r, info in enumerate(scene.model.rods):
         log.log_rod(f"{name}/rod_{ROD_NAMES[r]}", x[info.vertex_slice], False,
                     r_e[info.edge_slice], radii_at="edge", color=ROD_COLORS_RGB[r])
-    rep = contact_report(scene.contact, x, system.rest)
+    rep = contact_report(scene.contact, x, system.rest, system.state)
     between, within = _split_pairs(scene, rep)
     for key, pairs in (("contacts_between_rods", between), ("contacts_within_rods", within)):
         ia, ib = pairs[:, 0].astype(int), pairs[:, 1].astype(int)
@@ -81,7 +81,7 @@ def measure_rods(scene: TangleScene, system: RodSystem) -> list[dict]:
     """Each rod's measurements (module docstring), rod A first."""
     m = scene.model
     x, rest = system.state.x, system.rest
-    rep = contact_report(scene.contact, x, rest)
+    rep = contact_report(scene.contact, x, rest, system.state)
     between, within = _split_pairs(scene, rep)
     ev = m.edge_vertex
     lengths = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
@@ -141,7 +141,7 @@ def deepest_contact(scene: TangleScene, system: RodSystem) -> dict | None:
     the angle between the two centerlines there [deg] (90: the orthogonal contact of a
     tight clasp, Grandgeorge et al. 2021); None when the rods do not touch."""
     x = system.state.x
-    rep = contact_report(scene.contact, x, system.rest)
+    rep = contact_report(scene.contact, x, system.rest, system.state)
     between, _ = _split_pairs(scene, rep)
     if not between.shape[0]:
         return None

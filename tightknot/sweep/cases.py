@@ -13,7 +13,8 @@ tighten_steps; open: lambda_tolerance), with the defaults and ranges declared th
 knot: :data:`tightknot.study.params.KNOT_DEFAULTS`); :data:`CASE_KEYS` lists them. An open
 knot has exactly one level list, each level checked as the load it is (:data:`LEVELS`):
 ``pull_force`` [N] or ``target_lambda`` (Lambda_OC, physics.md sec. 2), each with at least
-one value. A ``contact="smoothed"`` case is tied one by one under ``--batch``.
+one value. A ``contact="smoothed"`` or ``"sectioned"`` case is tied one by one under
+``--batch``.
 """
 
 from __future__ import annotations
@@ -29,16 +30,16 @@ from tightknot.study.params import RUN_PARAMS, check_scene, knot_defaults, resol
 
 #: Prefix of the hashed text: bump it when the meaning of a parameter changes, so that a
 #: store written by an older version is not taken for finished work.
-_ID_SCHEMA = "tightknot-sweep-case-v1"
+_ID_SCHEMA = "tightknot-sweep-case-v2"
 
 #: The parameters of a case besides its knot and levels, in the order its dict lists them.
 #: The canonical dict holds exactly these: one more would change every case's id.
 CASE_KEYS: dict[str, tuple[str, ...]] = {
-    "closed": ("diameter", "youngs_modulus", "poisson", "density", "contact", "residual_tol",
-               "tighten_steps", "knot_type", "nodes", "twist", "l0_over_d0"),
-    "open": ("diameter", "youngs_modulus", "poisson", "density", "contact", "residual_tol",
-             "tighten_steps", "knot_type", "nodes", "twist", "length", "lambda_tolerance",
-             "grip_length", "grip_twist"),
+    "closed": ("diameter", "youngs_modulus", "poisson", "density", "contact", "section_modes",
+               "residual_tol", "tighten_steps", "knot_type", "nodes", "twist", "l0_over_d0"),
+    "open": ("diameter", "youngs_modulus", "poisson", "density", "contact", "section_modes",
+             "residual_tol", "tighten_steps", "knot_type", "nodes", "twist", "length",
+             "lambda_tolerance", "grip_length", "grip_twist"),
 }
 #: Run parameters that are not case parameters, and why: a sweep's path pulls level by
 #: level with its own steps, ties with tie()'s relaxation, has no end-distance levels

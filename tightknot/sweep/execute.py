@@ -33,8 +33,9 @@ BATCH_KEYS = ("knot", "twist", "contact", "tighten_steps", "residual_tol")
 def batch_key(params: Mapping[str, Any]) -> tuple | None:
     """What a case shares with the others of its batch, or None when it cannot be batched
     (open knots: tie_batch ties closed knots only; the "smoothed" contact level: its
-    Hessian couples whole windows of a rod, outside the batch's banded systems)."""
-    if params["knot"] != "closed" or params.get("contact") == "smoothed":
+    Hessian couples whole windows of a rod, outside the batch's banded systems; the
+    "sectioned" level: its section dofs are outside them too)."""
+    if params["knot"] != "closed" or params.get("contact") in ("smoothed", "sectioned"):
         return None
     return tuple(params[k] for k in BATCH_KEYS)
 

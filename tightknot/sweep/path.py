@@ -121,7 +121,8 @@ def measure(scene: KnotScene, result: TieResult) -> dict:
     _, r_v = vertex_radii(scene, x, result.system.rest)
     rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
                              radii=r_v, contact_tol=CONTACT_TOL)
-    out = summarise(scene, result, rep, contact_report(scene.contact, x))
+    out = summarise(scene, result, rep, contact_report(scene.contact, x, result.system.rest,
+                                                         result.system.state))
     # A level's mesh costs what a tie's does (the trade-off study's numbers, as run_knot says).
     out["resolution"] = resolution_note(scene.closed, scene.model.vertex_count)
     return out

@@ -1,0 +1,268 @@
+"""The sectioned contact level: the NumPy oracle's derivatives against finite differences,
+the Warp kernels against the oracle, the section field's energies, the level inside a rod
+system, bad input."""
+
+import copy
+import math
+
+import numpy as np
+import pytest
+import warp as wp
+
+from tightknot.contact import sectioned_kernels as sk
+from tightknot.contact.section_modes import mode_stiffness
+from tightknot.contact.sectioned import SectionedLayer, SectionSettings
+from tightknot.contact.sectioned_reference import (
+    EdgeSection,
+    PairSettings,
+    mode_rotation,
+    pair_terms,
+    swap_order,
+)
+from tightknot.rods.boundary import BoundaryConditions
+from tightknot.rods.builder import RodBuilder
+from tightknot.rods.material import Material
+from tightknot.rods.state import State
+from tightknot.solvers.system import RodSystem
+
+MODES = np.arange(2, 9)
+K = 2 * MODES.size
+GAUSS = (np.array([0.5 - 0.5 / math.sqrt(3.0), 0.5 + 0.5 / math.sqrt(3.0)]),
+         np.array([0.5, 0.5]))
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v)
+
+
+def _pair(seed: int = 1) -> tuple[EdgeSection, EdgeSection]:
+    """Two short crossing edges of unit-diameter rods overlapping by about 0.03 D, with
+    random sections, frames carried from slightly different accepted tangents and a
+    reference twist to the next edge's frame (D = 1: lengths in diameters)."""
+    rng = np.random.default_rng(seed)
+
+    def edge(x0: np.ndarray, x1: np.ndarray, arc: tuple[float, float]) -> EdgeSection:
+        t = _unit(x1 - x0 + 0.02 * rng.normal(size=3))
+        return EdgeSection(x0=x0, x1=x1, t_ref=t, d1_ref=_unit(np.cross(t, rng.normal(size=3))),
+                           coeffs0=0.01 * rng.normal(size=K), coeffs1=0.01 * rng.normal(size=K),
+                           twist1=0.3 * rng.normal(), rest=0.97 * float(np.linalg.norm(x1 - x0)),
+                           r0=0.5, arc=arc)
+
+    return (edge(np.array([-0.05, 0.0, 0.0]), np.array([0.05, 0.01, 0.0]), (0.0, 0.1)),
+            edge(np.array([0.01, -0.04, 0.985]), np.array([-0.01, 0.06, 1.0]), (3.0, 3.1)))
+
+
+SETTINGS = PairSettings(modes=MODES, gauss_xi=GAUSS[0], gauss_w=GAUSS[1], samples=32,
+                        kappa=1000.0, onset=1e-4)
+
+
+def _pack(a: EdgeSection, b: EdgeSection) -> np.ndarray:
+    return np.concatenate([a.x0, a.x1, b.x0, b.x1, a.coeffs0, a.coeffs1, b.coeffs0,
+                           b.coeffs1])
+
+
+def _unpack(a: EdgeSection, b: EdgeSection, q: np.ndarray) -> tuple[EdgeSection, EdgeSection]:
+    a, b = copy.copy(a), copy.copy(b)
+    a.x0, a.x1, b.x0, b.x1 = q[0:3], q[3:6], q[6:9], q[9:12]
+    a.coeffs0, a.coeffs1 = q[12:12 + K], q[12 + K:12 + 2 * K]
+    b.coeffs0, b.coeffs1 = q[12 + 2 * K:12 + 3 * K], q[12 + 3 * K:]
+    return a, b
+
+
+def test_oracle_derivatives_match_finite_differences() -> None:
+    a, b = _pair()
+    q0 = _pack(a, b)
+    ref = pair_terms(a, b, SETTINGS)
+    assert ref["energy"] > 0.0 and ref["pen_a"].max() > 0.01  # a real contact
+    eps = 1e-7
+    g_fd = np.zeros(q0.size)
+    h_fd = np.zeros((q0.size, q0.size))
+    for i in range(q0.size):
+        dq = np.zeros(q0.size)
+        dq[i] = eps
+        hi = pair_terms(*_unpack(a, b, q0 + dq), SETTINGS)
+        lo = pair_terms(*_unpack(a, b, q0 - dq), SETTINGS)
+        g_fd[i] = (hi["energy"] - lo["energy"]) / (2 * eps)
+        h_fd[:, i] = (hi["grad"] - lo["grad"]) / (2 * eps)
+    # exact: central differences of a C2 energy leave truncation eps^2 and round-off
+    # 1e-16 E / eps (measured 3.6e-10 of the largest entry)
+    assert np.max(np.abs(ref["grad"] - g_fd)) <= 1e-7 * np.max(np.abs(g_fd))
+    pos = slice(0, 12)
+    h = ref["hess"]
+    # over the vertex positions the Hessian is exact but for the frames' second
+    # derivatives by central differences (measured 1.4e-4 of the block here, with 0.027 D of
+    # penetration); an omitted term of the positions would be O(1)
+    err = np.linalg.norm(h[pos, pos] - h_fd[pos, pos]) / np.linalg.norm(h_fd[pos, pos])
+    assert err < 2e-3
+    # the section blocks leave out terms of relative order pen / R (here 0.05: measured
+    # 6e-3 of the whole Hessian)
+    assert np.linalg.norm(h - h_fd) / np.linalg.norm(h_fd) < 0.02
+
+
+def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, np.ndarray,
+                                                                         np.ndarray]:
+    """Energy, gradient and Hessian of the pair from the Warp kernel (both passes, node
+    blocks unpacked to the pair's local dofs)."""
+    f = wp.float64
+
+    def arr(x, dt):
+        return wp.array(np.asarray(x), dtype=dt)
+
+    nl = 12 + 4 * K
+    offs = [0, K, -1 if rigid_b else 2 * K, -1 if rigid_b else 3 * K]
+    model = [arr([[0, 1], [2, 3]], wp.vec2i), arr([0, 1], wp.int32), arr([0, 0], wp.int32),
+             arr([0.5, 0.5], f), arr([0.5, 0.5], f), arr([1.0, 1.0], f),
+             arr([0, int(rigid_b)], wp.int32), arr(offs, wp.int32),
+             arr([[0, 0], [0, 0]], wp.vec2i), arr([0.0, 0.0], f), arr(GAUSS[0], f),
+             arr(GAUSS[1], f), K, 32, 1000.0, 1e-4]
+    data = [arr(np.array([a.x0, a.x1, b.x0, b.x1]), wp.vec3d),
+            arr(np.concatenate([a.coeffs0, a.coeffs1, b.coeffs0, b.coeffs1]), f),
+            arr([a.t_ref, b.t_ref], wp.vec3d), arr([a.d1_ref, b.d1_ref], wp.vec3d),
+            arr([a.twist1, b.twist1], f), arr([a.rest, b.rest], f),
+            arr([a.arc, b.arc], wp.vec2d), arr([1.0, 1.0], f), arr([[0, 1]], wp.vec2i),
+            arr(np.arange(16), wp.int32)]
+    bsz = 3 + K
+    outs = [wp.zeros(2, dtype=f), wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),
+            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f)]
+    wp.launch(sk.DERIVATIVES, 2, model + data, outs)
+    g = outs[2].numpy().reshape(2, nl)
+    grad = g[0].copy()
+    grad[swap_order(K)] += g[1]
+    blocks = outs[3].numpy().reshape(4, 4, bsz, bsz)
+    # node n's local dofs: positions 3n..3n+2, sections 12 + K n ..
+    local = [np.r_[3 * n:3 * n + 3, 12 + K * n:12 + K * (n + 1)] for n in range(4)]
+    hess = np.zeros((nl, nl))
+    for i in range(4):
+        for j in range(4):
+            hess[np.ix_(local[i], local[j])] += blocks[i, j]
+    return float(outs[0].numpy().sum()), grad, hess
+
+
+@pytest.mark.parametrize("rigid_b", [False, True])
+def test_kernel_matches_the_oracle(rigid_b: bool) -> None:
+    a, b = _pair(3)
+    b.rigid = rigid_b
+    ref = pair_terms(a, b, SETTINGS)
+    energy, grad, hess = _kernel_pass(a, b, rigid_b)
+    keep = np.r_[0:12 + 2 * K] if rigid_b else np.r_[0:12 + 4 * K]  # b rigid: no dofs
+    # the same formulas in float64, the frames' differences included: round-off only
+    # (measured 1e-15 for energy and gradient, 8e-13 for the Hessian)
+    assert energy == pytest.approx(ref["energy"], rel=1e-12)
+    assert np.max(np.abs(grad[keep] - ref["grad"][keep])) <= 1e-12 * np.max(np.abs(ref["grad"]))
+    rh = ref["hess"][np.ix_(keep, keep)]
+    assert np.max(np.abs(hess[np.ix_(keep, keep)] - rh)) <= 1e-10 * np.max(np.abs(rh))
+
+
+def _straight_rod(n: int = 20, length: float = 3.0, twist: bool = False
+                  ) -> tuple[RodSystem, SectionedLayer]:
+    d0 = 0.0085
+    b = RodBuilder(twist=twist)
+    z = np.linspace(0.0, length * d0, n + 1)
+    b.add_rod(np.c_[np.zeros(n + 1), np.zeros(n + 1), z], d0, Material(1.25e6, 0.5, 1160.0))
+    model = b.finalize()
+    system = RodSystem(model, State.initial(model), BoundaryConditions(model))
+    layer = SectionedLayer(model, SectionSettings(max_mode=8))
+    system.add_term(layer)
+    return system, layer
+
+
+def test_a_uniform_section_field_has_no_gradient_energy() -> None:
+    # A straight rod's frames are parallel (zero reference twist): the same coefficients at
+    # every vertex are a uniform field, whose energy is the mode energy alone,
+    # sum_n (1/2) k_n (a_n^2 + b_n^2) L (docs/sectioned_level.md).
+    system, layer = _straight_rod()
+    c = 1e-4 * np.random.default_rng(0).normal(size=K)
+    extra = np.tile(c, system.model.vertex_count)
+    rest = system.model.edge_rest_length
+    e, g, _ = layer.section_energy(extra, system.state.m_ref, rest, True, False)
+    k = np.repeat([mode_stiffness(int(n), 1.25e6) for n in MODES], 2)
+    assert e == pytest.approx(0.5 * float(np.sum(k * c * c)) * rest.sum(), rel=1e-12)
+
+
+def test_a_field_turned_with_its_frames_has_no_gradient_energy() -> None:
+    # Frames turned by a reference twist m between edges: a shape carried with the frames
+    # (each vertex's coefficients in the frame of the edge it starts equal to Q(n m) times
+    # the last vertex's) is the same physical field: its gradient energy must vanish. The
+    # rod's last vertex is kept in the last edge's own frame.
+    system, layer = _straight_rod(n=6)
+    m_ref = np.full(system.model.joint_count, 0.3)
+    c = 1e-4 * np.random.default_rng(1).normal(size=K)
+    rows = [c]
+    for _ in range(system.model.vertex_count - 2):
+        rows.append(mode_rotation(MODES, 0.3) @ rows[-1])
+    rows.append(rows[-1])
+    rest = system.model.edge_rest_length
+    e, _, _ = layer.section_energy(np.concatenate(rows), m_ref, rest, False, False)
+    k = np.repeat([mode_stiffness(int(n), 1.25e6) for n in MODES], 2)
+    assert e == pytest.approx(0.5 * float(np.sum(k * c * c)) * rest.sum(), rel=1e-10)
+
+
+def test_section_energy_derivatives_match_finite_differences() -> None:
+    system, layer = _straight_rod(n=8)
+    rng = np.random.default_rng(2)
+    extra = 1e-4 * rng.normal(size=layer.dof_count)
+    m_ref = 0.2 * rng.normal(size=system.model.joint_count)
+    rest = system.model.edge_rest_length
+    _, g, coo = layer.section_energy(extra, m_ref, rest, True, True)
+    h = np.zeros((extra.size, extra.size))
+    np.add.at(h, (coo[0], coo[1]), coo[2])
+    eps = 1e-9
+    g_fd = np.array([(layer.section_energy(extra + eps * d, m_ref, rest, False, False)[0]
+                      - layer.section_energy(extra - eps * d, m_ref, rest, False, False)[0])
+                     / (2 * eps) for d in np.eye(extra.size)])
+    # a quadratic energy: central differences are exact up to round-off
+    assert np.max(np.abs(g - g_fd)) <= 1e-6 * np.max(np.abs(g))
+    assert np.allclose(h, h.T)
+    hv = h @ extra
+    assert np.max(np.abs(hv - g)) <= 1e-10 * np.max(np.abs(g))  # E = x^T H x / 2
+
+
+def test_the_level_in_a_rod_system_has_a_consistent_gradient_and_hessian() -> None:
+    # Two crossing rods pressed 0.01 D0 into each other, sections deformed at random.
+    d0 = 0.0085
+    mat = Material(1.25e6, 0.5, 1160.0)
+    b = RodBuilder(twist=False)
+    z = np.linspace(-1.5 * d0, 1.5 * d0, 25)
+    b.add_rod(np.c_[np.zeros(25), np.zeros(25), z], d0, mat)
+    b.add_rod(np.c_[z, np.full(25, 0.99 * d0), np.zeros(25)], d0, mat)
+    model = b.finalize()
+    rng = np.random.default_rng(0)
+    state = State.initial(model)
+    state.x += 1e-4 * d0 * rng.normal(size=state.x.shape)
+    system = RodSystem(model, state, BoundaryConditions(model))
+    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=32))
+    system.add_term(layer)
+    n = system.pattern.n
+    u = system.free_vector()
+    u[n:] = 0.002 * d0 * rng.normal(size=u.size - n)
+    _, g, h = system.evaluate(u)
+    assert system.last_split.extra["contact"] > 0.0
+    step = 1e-3
+    for _ in range(3):
+        d = 1e-4 * d0 * rng.normal(size=u.size)
+        e_hi = system.evaluate(u + step * d, False, False)[0]
+        e_lo = system.evaluate(u - step * d, False, False)[0]
+        g_hi = system.evaluate(u + step * d, True, False)[1]
+        g_lo = system.evaluate(u - step * d, True, False)[1]
+        # the directional derivative is exact (measured 1e-9 relative)
+        assert g @ d == pytest.approx((e_hi - e_lo) / (2 * step), rel=1e-6)
+        # the Hessian misses terms of relative order pen / R in the sections' blocks
+        # (measured 7e-3 here, at a 0.01 D0 overlap of round sections)
+        hd = (g_hi - g_lo) / (2 * step)
+        assert np.linalg.norm(h @ d - hd) <= 0.03 * np.linalg.norm(hd)
+
+
+@pytest.mark.parametrize(("kwargs", "word"), [({"max_mode": 3}, "section_modes"),
+                                               ({"max_mode": 8.5}, "section_modes"),
+                                               ({"samples": 16}, "samples"),
+                                               ({"penalty": -1.0}, "penalty"),
+                                               ({"onset": 0.5}, "onset")])
+def test_bad_settings_name_the_option(kwargs: dict, word: str) -> None:
+    with pytest.raises(ValueError, match=word):
+        SectionSettings(**kwargs)
+
+
+def test_too_many_modes_for_the_kernels_are_refused() -> None:
+    system, _ = _straight_rod(n=4)
+    with pytest.raises(ValueError, match="section_modes must be <= 12"):
+        SectionedLayer(system.model, SectionSettings(max_mode=13, samples=64))

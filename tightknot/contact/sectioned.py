@@ -1,0 +1,652 @@
+"""The sectioned contact level: each edge's cross-section is state, pressed by its partners.
+
+Where the compliant level reads contact width, pressure and area off a law of centerline
+distance, here the section's boundary, r(phi) = R + sum_{n=2..N} (a_n cos n phi + b_n sin n
+phi), is a field along the rod: every vertex carries its coefficients c = (a_2, b_2, ...,
+a_N, b_N) as degrees of freedom of the rod system (``State.extra``, 2 (N - 1) per vertex),
+interpolated linearly along each edge (:mod:`tightknot.contact.sectioned_reference`: the
+frames, the interpolation and the contact), and the section's deformation, its contact
+width, pressure and area come out of the equilibrium (docs/sectioned_level.md). The energy
+adds to the rod's elastic energy, per edge of rest length h with the coefficients c_0, c_1'
+of its two vertices in its frame (c_1' = Q^T c_1, Q turning mode n by n m, m the reference
+twist to the next edge's frame: the accepted state's, fixed within a Newton iteration):
+
+* **mode energy**, int (1/2) k_n |c(s)|^2 ds = (k_n h / 6) (|c_0|^2 + c_0 . c_1' + |c_1'|^2)
+  per mode, the plane-strain stiffness of an incompressible disk k_n = 2 pi mu (n^2 - 1) / n,
+  mu = E / 3 (:func:`tightknot.contact.section_modes.mode_stiffness`, confirmed by the FEM
+  within 1 %);
+* **axial gradient energy**, int (1/2) g_n |dc/ds|^2 ds = (1/2) g_n |c_1' - c_0|^2 / h with
+  g_n = k_n l_n^2, l_n the decay lengths of a mode along the FEM's 3D rod
+  (:class:`SectionCalibration`; modes above 4 at l_4 4 / n);
+* **the mean radius from the area**, R^2 = r0^2 lambda^(-2 nu) - |c|^2 / 2 (Parseval): a
+  squeezed section lengthens its edge, the incompressible Poisson effect;
+* **contact between deformed boundaries**: a stiff rounded penalty on the penetration of
+  each section's boundary samples into its partners' surfaces
+  (:mod:`tightknot.contact.sectioned_reference`, kernels in
+  :mod:`tightknot.contact.sectioned_kernels`), pressure kappa pen with kappa = penalty
+  E / D0, the penalty the local compliance of the modes above N fitted to the FEM's
+  plane-strain squeeze (:class:`SectionCalibration`).
+
+The broad phase, the exclusion window, the step bound (no pass-through) and the independent
+proximity check are the compliant level's (:class:`tightknot.contact.layer.ContactLayer`):
+they act on the centerlines. Rods listed in ``rigid_rods`` keep round rigid sections of
+their rest radius and own no section dofs (the FEM scenes' rigid counter-bodies).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import warp as wp
+
+from tightknot.contact import sectioned_kernels as sk
+from tightknot.contact.layer import ContactLayer
+from tightknot.contact.section_modes import mode_stiffness
+from tightknot.rods.model import Model
+from tightknot.rods.staging import Staging
+from tightknot.rods.term import BlockHessian
+
+#: Smallest mode count: an ellipse (N = 2) cannot wrap a convex partner; the nip needs the
+#: section to turn a concave face to it, which takes n = 3 and 4.
+MIN_MODES = 4
+
+_CALIBRATION_FILE = Path(__file__).resolve().parents[1] / "data" / "section_calibration.json"
+
+
+@dataclass(frozen=True)
+class SectionCalibration:
+    """What the sectioned level takes from the FEM (docs/sectioned_level.md).
+
+    Attributes:
+        decay_length_over_d0: how far mode n spreads along a 3D rod of the FEM's solid, l_n
+            / D0 (:func:`tightknot.fem.section_modes.rod_mode_decay`, fine mesh); modes above
+            the largest measured n take l_N' N' / n (a surface wave's 1/n), reported.
+        penalty_by_max_mode: the contact penalty over E/D0 for each mode count N, fitted to
+            the FEM's plane-strain squeeze (:func:`tightknot.fem.section_calibration.
+            calibrate_section_penalty`): the local compliance of the modes above N.
+        source: where the numbers come from.
+    """
+
+    decay_length_over_d0: dict[int, float]
+    penalty_by_max_mode: dict[int, float]
+    source: str
+
+    @classmethod
+    def from_json(cls, path: str | Path | None = None) -> SectionCalibration:
+        """The shipped calibration (or the file ``path``); a file without the section's
+        calibration is refused, naming what it lacks."""
+        where = Path(path) if path is not None else _CALIBRATION_FILE
+        d = json.loads(where.read_text())
+        missing = [k for k in ("decay_length_over_d0", "penalty_by_max_mode") if k not in d]
+        if missing:
+            raise ValueError(f"{where} holds no section calibration ({', '.join(missing)} "
+                             "missing): the sectioned level needs one "
+                             "(tightknot.fem.section_calibration)")
+        decay = {int(k): float(v) for k, v in d["decay_length_over_d0"].items()}
+        if not all(n in decay for n in (2, 3, 4)):
+            raise ValueError(f"{where}: the decay lengths of modes 2, 3 and 4 are required")
+        pen = {int(k): float(v["penalty"]) for k, v in d["penalty_by_max_mode"].items()}
+        date = d.get("provenance", {}).get("date", "?")
+        return cls(decay, pen, f"FEM calibration {where.name} ({date})")
+
+    def decay_length(self, n: int) -> tuple[float, bool]:
+        """l_n / D0 of mode ``n`` and whether it was measured (else extrapolated)."""
+        if n in self.decay_length_over_d0:
+            return self.decay_length_over_d0[n], True
+        top = max(self.decay_length_over_d0)
+        return self.decay_length_over_d0[top] * top / n, False
+
+    def penalty(self, max_mode: int) -> float:
+        """The calibrated penalty [E/D0] of ``max_mode`` modes."""
+        if max_mode not in self.penalty_by_max_mode:
+            known = sorted(self.penalty_by_max_mode)
+            raise ValueError(f"section_modes {max_mode} has no calibrated penalty (the "
+                             f"calibration covers {known[0]} to {known[-1]})")
+        return self.penalty_by_max_mode[max_mode]
+
+
+@dataclass(frozen=True)
+class SectionSettings:
+    """Settings of the sectioned level.
+
+    Attributes:
+        max_mode: highest Fourier mode N of the boundary (>= 4).
+        samples: boundary samples per section M (angles 2 pi (k + 1/2) / M), >= 4 N: a
+            round section between samples sits r (1 - cos(pi/M)) inside their polygon
+            (6e-4 D0 at M = 64, below the smallest approach the FEM compares).
+        penalty: penalty stiffness over E/D0 [-] (pressure kappa pen, kappa = penalty E/D0);
+            None: the calibrated one of ``max_mode`` (:class:`SectionCalibration`).
+        onset: the penalty's rounded onset over D0 [-].
+    """
+
+    max_mode: int = 8
+    samples: int = 64
+    penalty: float | None = None
+    onset: float = 1e-4
+
+    def __post_init__(self) -> None:
+        if (isinstance(self.max_mode, bool) or int(self.max_mode) != self.max_mode
+                or self.max_mode < MIN_MODES):
+            raise ValueError(f"section_modes must be an integer >= {MIN_MODES} (an ellipse "
+                             f"cannot wrap a convex partner), got {self.max_mode!r}")
+        if int(self.samples) != self.samples or self.samples < 4 * self.max_mode:
+            raise ValueError(f"section samples must be an integer >= 4 x section_modes = "
+                             f"{4 * self.max_mode}, got {self.samples!r}")
+        if self.penalty is not None and not (math.isfinite(self.penalty) and self.penalty > 0.0):
+            raise ValueError(f"section penalty must be finite and > 0, got {self.penalty!r}")
+        if not (math.isfinite(self.onset) and 0.0 < self.onset < 0.01):
+            raise ValueError(f"section penalty onset must be in (0, 0.01) D0, got "
+                             f"{self.onset!r}")
+
+    @property
+    def coeff_count(self) -> int:
+        """Section coefficients per edge, 2 (N - 1)."""
+        return 2 * (self.max_mode - 1)
+
+
+class SectionedLayer(ContactLayer):
+    """The sectioned contact level of a model (module docstring).
+
+    Args:
+        model: the rods.
+        settings: the section's modes, samples and penalty.
+        rigid_rods: indices of rods whose sections stay round and rigid (rest radius).
+        **layer: the compliant layer's settings for the broad phase, exclusion window and
+            step bound (``gauss_points``, ``exclusion_factor``, ``hard_fraction``).
+    """
+
+    assembles_in_place = False
+
+    def __init__(self, model: Model, settings: SectionSettings | None = None,
+                 rigid_rods: Sequence[int] = (),
+                 calibration: SectionCalibration | None = None, **layer) -> None:
+        self.section = settings or SectionSettings()
+        if self.section.coeff_count > sk.MAX_COEFF:
+            raise ValueError(f"section_modes must be <= {sk.MAX_COEFF // 2 + 1}, got "
+                             f"{self.section.max_mode}")
+        super().__init__(model, **layer)
+        #: The FEM calibration the section's gradient energy and penalty come from.
+        self.calibration = calibration or SectionCalibration.from_json()
+        #: The contact penalty over E/D0 (the calibrated one unless the settings give one).
+        self.penalty = (self.section.penalty if self.section.penalty is not None
+                        else self.calibration.penalty(self.section.max_mode))
+        m = model
+        k = self.section.coeff_count
+        rigid = set(int(r) for r in rigid_rods)
+        bad = [r for r in rigid if not 0 <= r < len(m.rods)]
+        if bad:
+            raise ValueError(f"rigid_rods: no rod {bad[0]} (the model has {len(m.rods)})")
+        #: Whether each edge's and each vertex's section is rigid.
+        self.edge_rigid = np.array([int(r) in rigid for r in m.edge_rod], dtype=bool)
+        self.vertex_rigid = np.array([int(r) in rigid for r in m.vertex_rod], dtype=bool)
+        offset = np.full(m.vertex_count, -1, dtype=np.int64)
+        deformable = np.flatnonzero(~self.vertex_rigid)
+        offset[deformable] = np.arange(deformable.size) * k
+        #: First coefficient of each vertex's section in the term's dofs (-1: rigid).
+        self.vertex_offset = offset
+        self.dof_count = int(deformable.size * k)
+        self.modes = np.arange(2, self.section.max_mode + 1)
+        #: Rest radius r0 [m] and Poisson ratio of each edge.
+        self.edge_r0 = np.asarray(m.edge_radius, dtype=np.float64)
+        self.edge_nu = np.array([m.rods[r].material.poisson_ratio for r in m.edge_rod])
+        # Mode stiffness k_n [Pa] and gradient stiffness g_n = k_n l_n^2 [N] per edge
+        # (a_n and b_n alike).
+        stiff = np.array([[mode_stiffness(int(n), e) for n in self.modes]
+                          for e in self.edge_modulus])
+        lengths = np.array([self.calibration.decay_length(int(n))[0] for n in self.modes])
+        self.mode_stiff = np.repeat(stiff, 2, axis=1)
+        d0 = 2.0 * self.edge_r0
+        self.grad_stiff = self.mode_stiff * (np.repeat(lengths, 2)[None, :]
+                                             * d0[:, None]) ** 2
+        #: Which decay lengths were extrapolated (modes above 4).
+        self.extrapolated_modes = [int(n) for n in self.modes
+                                   if not self.calibration.decay_length(int(n))[1]]
+        ev = m.edge_vertex.astype(np.int64)
+        self._ev = ev
+        # The joint after each edge (its reference twist turns the next vertex's section
+        # into the edge's frame), -1 at the end of an open rod.
+        nxt = np.full(m.edge_count, -1, dtype=np.int64)
+        if m.joint_count:
+            nxt[m.joint_edge[:, 0]] = np.arange(m.joint_count)
+        self._next_joint = nxt
+        self._section_edges = np.flatnonzero(~self.edge_rigid)
+        # Nodes of the Hessian's blocks: each vertex's 3 coordinates and its K coefficients.
+        nodes = m.vertex_count
+        pos = m.vertex_dof.astype(np.int64)[:, None] + np.arange(3)
+        sec = np.where(offset[:, None] >= 0, m.dof_count + offset[:, None] + np.arange(k), -1)
+        self._node_dofs = np.concatenate([pos, sec], axis=1)
+        # The node pairs the section energy always couples (each deformable edge's ends).
+        se = ev[self._section_edges]
+        pairs = np.concatenate([se, se[:, ::-1], se[:, [0, 0]], se[:, [1, 1]]])
+        self._section_keys = np.unique(pairs[:, 0] * nodes + pairs[:, 1])
+        # term dof -> (its vertex, its index within the vertex's node)
+        self._dof_node = np.repeat(deformable, k)
+        self._dof_local = 3 + np.tile(np.arange(k), deformable.size)
+        dev = self.device
+        f64 = wp.float64
+        ends = np.zeros((m.edge_count, 2), dtype=np.int32)
+        for rod in m.rods:
+            if not rod.closed:
+                ends[rod.edge_slice.start, 0] = 1
+                ends[rod.edge_slice.stop - 1, 1] = 1
+        g_xi, g_w = self.settings.gauss
+        self._model_args = [
+            self.broad_phase.edge_vertex, self.broad_phase.edge_rod,
+            self.broad_phase.rod_closed,
+            wp.array(self.edge_r0, dtype=f64, device=dev),
+            wp.array(self.edge_nu, dtype=f64, device=dev),
+            wp.array(self.edge_modulus, dtype=f64, device=dev),
+            wp.array(self.edge_rigid.astype(np.int32), dtype=wp.int32, device=dev),
+            wp.array(offset.astype(np.int32), dtype=wp.int32, device=dev),
+            wp.array(ends, dtype=wp.vec2i, device=dev),
+            self.broad_phase.edge_exclusion,
+            wp.array(g_xi, dtype=f64, device=dev), wp.array(g_w, dtype=f64, device=dev),
+            k, int(self.section.samples), float(self.penalty), float(self.section.onset),
+        ]
+        self._in_coeff = Staging(f64, dev)
+        self._in_t = Staging(wp.vec3d, dev)
+        self._in_d1 = Staging(wp.vec3d, dev)
+        self._in_twist = Staging(f64, dev)
+        self._in_rest = Staging(f64, dev)
+        self._in_margin = Staging(f64, dev)
+        #: The last evaluation: candidate pairs, each pair's deepest penetration [m].
+        self.last_section_pairs = np.zeros((0, 2), dtype=np.int64)
+        self.last_penetration = np.zeros(0)
+
+    # -- the section field -----------------------------------------------------------------
+    def end_twist(self, m_ref: np.ndarray) -> np.ndarray:
+        """Per edge, the reference twist [rad] from its frame to the frame its second
+        vertex's section is stored in (the next edge's; 0 at the end of an open rod)."""
+        nxt = self._next_joint
+        out = np.zeros(nxt.size)
+        has = nxt >= 0
+        out[has] = m_ref[nxt[has]]
+        return out
+
+    def edge_sections(self, extra: np.ndarray, m_ref: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """Each edge's (E, K) coefficients [m] at its first vertex and at its second, both
+        in the edge's frame (zero on rigid sections)."""
+        k = self.section.coeff_count
+        full = np.zeros((self.model.vertex_count, k))
+        if extra.size:
+            full[~self.vertex_rigid] = extra.reshape(-1, k)
+        c0 = full[self._ev[:, 0]]
+        c1 = _rotate(full[self._ev[:, 1]], self.modes, self.end_twist(m_ref), transpose=True)
+        return c0, c1
+
+    def slid_sections(self, extra: np.ndarray, old_frames: tuple[np.ndarray, np.ndarray],
+                      new_frames: tuple[np.ndarray, np.ndarray], k: int,
+                      rotation: np.ndarray) -> np.ndarray:
+        """The section dofs [m] of a single open rod whose material slid by ``k`` edges along
+        it (vertex i takes vertex i - k's place) and turned by ``rotation`` (3 x 3): each
+        vertex's coefficients move with it, re-expressed in the new frame of the edge that
+        stores them (``new_frames`` = (t_ref, d1_ref)) from the turned old one (mode n by n
+        times the angle between the two directors); vertices with no source get round
+        sections."""
+        m = self.model
+        nk = self.section.coeff_count
+        n = m.vertex_count
+        if len(m.rods) != 1 or m.rods[0].closed or self.dof_count != n * nk:
+            raise ValueError("sections slide along a single open deformable rod only")
+        src = np.arange(n) - int(k)
+        ok = (src >= 0) & (src < n)
+        last_edge = m.edge_count - 1
+        store_new = np.minimum(np.arange(n), last_edge)
+        store_old = np.minimum(np.clip(src, 0, n - 1), last_edge)
+        t_new, d1_new = new_frames[0][store_new], new_frames[1][store_new]
+        d1_old = old_frames[1][store_old] @ rotation.T
+        d1_old -= np.einsum("ij,ij->i", d1_old, t_new)[:, None] * t_new
+        angle = np.arctan2(np.einsum("ij,ij->i", np.cross(d1_old, d1_new), t_new),
+                           np.einsum("ij,ij->i", d1_old, d1_new))
+        old = extra.reshape(n, nk)
+        out = np.zeros((n, nk))
+        out[ok] = _rotate(old[src[ok]], self.modes, angle[ok])
+        return out.ravel()
+
+    def section_energy(self, extra: np.ndarray, m_ref: np.ndarray, rest: np.ndarray,
+                       want_grad: bool, want_hess: bool
+                       ) -> tuple[float, np.ndarray | None, tuple | None]:
+        """Mode and axial-gradient energy [J] of the vertex sections ``extra`` [m] at edge
+        rest lengths ``rest`` [m] and joint reference twists ``m_ref`` [rad] (module
+        docstring), its gradient over ``extra`` and its Hessian COO over the term's dofs."""
+        k = self.section.coeff_count
+        e = self._section_edges
+        grad = np.zeros(extra.size) if (want_grad or want_hess) else None
+        if e.size == 0:
+            empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+            return 0.0, grad, (empty if want_hess else None)
+        h = rest[e]
+        twist = self.end_twist(m_ref)[e]
+        # per edge and coefficient: alpha = k h / 3 + g / h, beta = k h / 6 - g / h
+        alpha = self.mode_stiff[e] * h[:, None] / 3.0 + self.grad_stiff[e] / h[:, None]
+        beta = self.mode_stiff[e] * h[:, None] / 6.0 - self.grad_stiff[e] / h[:, None]
+        off0 = self.vertex_offset[self._ev[e, 0]]
+        off1 = self.vertex_offset[self._ev[e, 1]]
+        idx0 = off0[:, None] + np.arange(k)
+        idx1 = off1[:, None] + np.arange(k)
+        c0 = extra[idx0]
+        c1 = extra[idx1]
+        c1r = _rotate(c1, self.modes, twist, transpose=True)  # c_1' = Q^T c_1
+        energy = float(np.sum(0.5 * alpha * (c0 * c0 + c1 * c1) + beta * c0 * c1r))
+        if grad is not None:
+            np.add.at(grad, idx0, alpha * c0 + beta * c1r)
+            np.add.at(grad, idx1, alpha * c1 + beta * _rotate(c0, self.modes, twist))
+        coo = None
+        if want_hess:
+            # per mode: alpha I on (c0, c0) and (c1, c1), beta Q^T on (c0, c1), beta Q on
+            # (c1, c0); Q = [[cos, sin], [-sin, cos]] of n m
+            ang = self.modes[None, :] * twist[:, None]
+            cs, sn = np.cos(ang), np.sin(ang)
+            a_n = alpha[:, 0::2]
+            b_n = beta[:, 0::2]
+            base0 = off0[:, None] + 2 * np.arange(k // 2)[None, :]
+            base1 = off1[:, None] + 2 * np.arange(k // 2)[None, :]
+            zero = np.zeros_like(a_n)
+            rows, cols, vals = [], [], []
+            for r_i, c_i, blk in ((base0, base0, (a_n, zero, zero, a_n)),
+                                  (base1, base1, (a_n, zero, zero, a_n)),
+                                  (base0, base1, (b_n * cs, -b_n * sn, b_n * sn, b_n * cs)),
+                                  (base1, base0, (b_n * cs, b_n * sn, -b_n * sn, b_n * cs))):
+                for (dr, dc), val in zip(((0, 0), (0, 1), (1, 0), (1, 1)), blk, strict=True):
+                    rows.append((r_i + dr).ravel())
+                    cols.append((c_i + dc).ravel())
+                    vals.append(val.ravel())
+            coo = (np.concatenate(rows), np.concatenate(cols), np.concatenate(vals))
+        return energy, grad, coo
+
+    # -- contact between deformed boundaries ---------------------------------------------
+    def _margins(self, x: np.ndarray, extra: np.ndarray, rest: np.ndarray) -> np.ndarray:
+        """Each edge's reach [m]: its largest boundary radius (the rest radius grown by 10 %
+        for compression, plus 1.5 times its vertices' coefficients' absolute sums) and half
+        its length (a partner's surface extends half an edge past its vertices)."""
+        ev = self._ev
+        length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
+        reach = 1.1 * self.edge_r0 * np.maximum(1.0, (length / rest) ** (-self.edge_nu))
+        if extra.size:
+            k = self.section.coeff_count
+            vsum = np.zeros(self.model.vertex_count)
+            vsum[~self.vertex_rigid] = np.abs(extra.reshape(-1, k)).sum(axis=1)
+            reach += 1.5 * (vsum[ev[:, 0]] + vsum[ev[:, 1]])
+        return reach + 0.5 * length
+
+    def _candidates(self, x: np.ndarray, extra: np.ndarray, rest: np.ndarray
+                    ) -> tuple[wp.array, wp.array, wp.array, wp.array]:
+        broad = self.broad_phase
+        wx = broad.x_in.put(x)
+        arcs, rod_len = broad.arcs(rest)
+        margin = self._in_margin.put(self._margins(x, extra, rest))
+        # A sample's projection reaches half a partner edge past its vertices: keep pairs
+        # whose edges lie up to that much inside the exclusion window.
+        reach = 0.5 * float(np.max(rest)) / float(np.min(self.exclusion))
+        pairs = broad.candidates(wx, broad.zero_dx, margin, arcs, rod_len,
+                                 window=max(0.0, self.settings.candidate_window - reach))
+        return wx, pairs, arcs, rod_len
+
+    def _launch(self, kernel: wp.Kernel, wx: wp.array, pairs: wp.array,
+                data: list[wp.array], derivatives: bool = False, report: bool = False,
+                slots: np.ndarray | None = None, block_count: int = 0
+                ) -> dict[str, np.ndarray]:
+        """Launch ``kernel`` over both passes of ``pairs`` with the state arrays ``data``
+        (coefficients, frames, end twists, rest lengths, arcs, rod lengths); with
+        ``derivatives``, the Hessian goes into ``block_count`` node-pair blocks, pair p's
+        16 at ``slots[p]`` (nodes a0, a1, b0, b1)."""
+        dev = self.device
+        f64 = wp.float64
+        threads = 2 * pairs.shape[0]
+        nl = 12 + 4 * self.section.coeff_count
+        ng = len(self.settings.gauss[0])
+        energy = wp.zeros(threads, dtype=f64, device=dev)
+        pen_max = wp.zeros(threads, dtype=f64, device=dev)
+        grad = wp.zeros(threads * nl if derivatives else 1, dtype=f64, device=dev)
+        b = 3 + self.section.coeff_count
+        blocks = wp.zeros(block_count * b * b if derivatives else 1, dtype=f64, device=dev)
+        w_slots = wp.array(slots.astype(np.int32).ravel() if derivatives else np.zeros(1, np.int32),
+                           dtype=wp.int32, device=dev)
+        ns = threads * ng * self.section.samples if report else 1
+        s_pen = wp.zeros(ns, dtype=f64, device=dev)
+        s_wt = wp.zeros(ns, dtype=f64, device=dev)
+        wp.launch(kernel, threads, [*self._model_args, wx, *data,
+                                    self.broad_phase.buffer_of(pairs), w_slots],
+                  [energy, pen_max, grad, blocks, s_pen, s_wt], device=dev)
+        out = {"energy": energy.numpy(), "pen_max": pen_max.numpy()}
+        if derivatives:
+            out["grad"] = grad.numpy().reshape(threads, nl)
+            out["blocks"] = blocks.numpy().reshape(block_count, b, b)
+        if report:
+            out["pen"] = s_pen.numpy().reshape(threads, ng, self.section.samples)
+            out["weight"] = s_wt.numpy().reshape(threads, ng, self.section.samples)
+        return out
+
+    def _state_arrays(self, extra: np.ndarray, t_ref: np.ndarray, d1_ref: np.ndarray,
+                      m_ref: np.ndarray, rest: np.ndarray, arcs: wp.array,
+                      rod_len: wp.array) -> list[wp.array]:
+        """The kernels' Data-in arrays after the positions."""
+        return [self._in_coeff.put(extra if extra.size else np.zeros(1)),
+                self._in_t.put(t_ref), self._in_d1.put(d1_ref),
+                self._in_twist.put(self.end_twist(m_ref)), self._in_rest.put(rest), arcs,
+                rod_len]
+
+    def _pass_dofs(self, pairs: np.ndarray) -> np.ndarray:
+        """Extended dofs (model dofs, then model.dof_count + the term's) of each pass's
+        local dofs (2 P, L): pass 2p takes (a, b), pass 2p + 1 takes (b, a); -1 for the
+        coefficients of a rigid section."""
+        m = self.model
+        k = self.section.coeff_count
+        ev = self._ev
+        order = np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)  # (2P, 2): A, B
+        verts = np.concatenate([ev[order[:, 0]], ev[order[:, 1]]], axis=1)  # (2P, 4)
+        pos = (m.vertex_dof.astype(np.int64)[verts][:, :, None] + np.arange(3)).reshape(-1, 12)
+        off = self.vertex_offset[verts]  # (2P, 4)
+        sec = np.where(off[:, :, None] >= 0, m.dof_count + off[:, :, None] + np.arange(k), -1)
+        return np.concatenate([pos, sec.reshape(-1, 4 * k)], axis=1)
+
+    def contact_energy(self, x: np.ndarray, extra: np.ndarray,
+                       frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray,
+                       want_grad: bool, want_hess: bool
+                       ) -> tuple[float, np.ndarray | None, np.ndarray | None, tuple | None]:
+        """Contact energy [J] of the deformed sections at positions ``x`` [m], vertex
+        sections ``extra`` [m] and edge rest lengths ``rest`` [m], carried in the accepted
+        ``frames`` (t_ref, d1_ref, m_ref); its gradient over positions (V, 3) and over the
+        term's dofs, and its Hessian in node blocks (the section energy's node pairs
+        included, zero)."""
+        m = self.model
+        rest = np.asarray(rest, dtype=np.float64)
+        self.energy.last_rest = rest.copy()
+        wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
+        data = self._state_arrays(extra, *frames, rest, arcs, rod_len)
+        npairs = pairs.shape[0]
+        g_x = np.zeros((m.vertex_count, 3)) if (want_grad or want_hess) else None
+        g_c = np.zeros(self.dof_count) if (want_grad or want_hess) else None
+        empty = self._empty_blocks() if want_hess else None
+        if npairs == 0:
+            self.last_section_pairs = np.zeros((0, 2), dtype=np.int64)
+            self.last_penetration = np.zeros(0)
+            return 0.0, g_x, g_c, empty
+        first = self._launch(sk.ENERGY, wx, pairs, data)
+        host_pairs = pairs.numpy().astype(np.int64)
+        self.last_section_pairs = host_pairs
+        self.last_penetration = first["pen_max"].reshape(-1, 2).max(axis=1)
+        energy = float(first["energy"].sum())
+        if not (want_grad or want_hess) or not math.isfinite(energy):
+            return energy, g_x, g_c, empty
+        active = np.flatnonzero(first["energy"].reshape(-1, 2).sum(axis=1) > 0.0)
+        if active.size == 0:
+            return energy, g_x, g_c, empty
+        act_pairs = host_pairs[active]
+        wp_act = wp.array(act_pairs.astype(np.int32), dtype=wp.vec2i, device=self.device)
+        slots, keys = None, None
+        if want_hess:
+            ev = self._ev
+            nodes = np.concatenate([ev[act_pairs[:, 0]], ev[act_pairs[:, 1]]], axis=1)  # (A, 4)
+            pair_keys = (nodes[:, :, None] * m.vertex_count + nodes[:, None, :]).reshape(-1)
+            keys, inverse = np.unique(np.concatenate([self._section_keys, pair_keys]),
+                                      return_inverse=True)
+            slots = inverse[self._section_keys.size:].reshape(-1, 16)
+        else:  # a gradient only: the kernel's Hessian goes to one discarded block
+            slots = np.zeros((act_pairs.shape[0], 16), dtype=np.int64)
+        out = self._launch(sk.DERIVATIVES, wx, wp_act, data, derivatives=True, slots=slots,
+                           block_count=1 if keys is None else keys.size)
+        dofs = self._pass_dofs(act_pairs)  # (2A, L)
+        keep = dofs >= 0
+        full = np.bincount(dofs[keep], weights=out["grad"][keep],
+                           minlength=m.dof_count + self.dof_count)
+        g_x = full[m.position_dofs]
+        g_c = full[m.dof_count:]
+        hess = None
+        if want_hess:
+            hess = BlockHessian(self._node_dofs,
+                                np.stack([keys // m.vertex_count, keys % m.vertex_count], axis=1),
+                                out["blocks"])
+        return energy, g_x, g_c, hess
+
+    def _empty_blocks(self) -> BlockHessian:
+        """The section energy's node pairs with zero blocks."""
+        nodes = self.model.vertex_count
+        keys = self._section_keys
+        b = 3 + self.section.coeff_count
+        return BlockHessian(self._node_dofs, np.stack([keys // nodes, keys % nodes], axis=1),
+                            np.zeros((keys.size, b, b)))
+
+    def _add_coo(self, hess: BlockHessian, coo: tuple) -> None:
+        """Add a COO Hessian over the term's own dofs into ``hess``'s blocks (its node
+        pairs are among them)."""
+        rows, cols, vals = coo
+        nodes = self.model.vertex_count
+        key = self._dof_node[rows] * nodes + self._dof_node[cols]
+        hk = hess.keys[:, 0] * nodes + hess.keys[:, 1]
+        slot = np.searchsorted(hk, key)
+        b = hess.blocks.shape[1]
+        flat = hess.blocks.reshape(-1)
+        np.add.at(flat, (slot * b + self._dof_local[rows]) * b + self._dof_local[cols], vals)
+
+    # -- measurements ----------------------------------------------------------------------
+    def section_report(self, x: np.ndarray, extra: np.ndarray,
+                       frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
+                       ) -> dict[str, np.ndarray]:
+        """Per-vertex section outputs of a state (positions ``x`` [m], sections ``extra``
+        [m], accepted ``frames``, edge rest lengths ``rest`` [m]), read off the state:
+
+        * ``contact_width_fraction``: L_c, the part of the deformed boundary's length whose
+          samples penetrate a partner (any), over the boundary's length, at the vertex's
+          edges' Gauss circles (the larger of the vertex's edges);
+        * ``peak_pressure_over_E``, ``mean_pressure_over_E``: the penalty's pressure
+          kappa pen over E at those samples, largest and mean;
+        * ``force_per_length``: the contact force per unit rest length [N/m] (sum of the
+          samples' kappa pen times their rest area, over the edge);
+        * ``half_width``: L_c pi D0 / 4 [m], the half-width of each of two opposite
+          contacts sharing the width;
+        * ``area_ratio``: A/A0 = lambda^(-2 nu), lambda the stretch of the vertex's edges
+          (the modes keep the area, docs/sectioned_level.md).
+        """
+        m = self.model
+        rest = np.asarray(rest, dtype=np.float64)
+        ev = self._ev
+        n_e, n_v = m.edge_count, m.vertex_count
+        ng = len(self.settings.gauss[0])
+        ms = self.section.samples
+        wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
+        data = self._state_arrays(extra, *frames, rest, arcs, rod_len)
+        pen = np.zeros((n_e, ng, ms))
+        if pairs.shape[0]:
+            out = self._launch(sk.REPORT, wx, pairs, data, report=True)
+            host = pairs.numpy().astype(np.int64)
+            owner = np.stack([host[:, 0], host[:, 1]], axis=1).reshape(-1)  # pass -> its A
+            p = np.where(out["weight"] > 0.0, out["pen"], 0.0)
+            np.maximum.at(pen, owner, np.maximum(p, 0.0))
+        # the deformed boundary's length element r ds at each sample, per Gauss circle
+        c0, c1 = self.edge_sections(extra, frames[2])
+        phis = 2.0 * math.pi * (np.arange(ms) + 0.5) / ms
+        npk = np.outer(phis, self.modes)
+        basis = np.empty((ms, self.section.coeff_count))
+        slope = np.empty_like(basis)
+        basis[:, 0::2], basis[:, 1::2] = np.cos(npk), np.sin(npk)
+        slope[:, 0::2], slope[:, 1::2] = -self.modes * np.sin(npk), self.modes * np.cos(npk)
+        length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
+        lam = length / rest
+        big_r0 = self.edge_r0 * lam ** (-self.edge_nu)
+        in_contact = pen > 0.0
+        width = np.zeros((n_e, ng))
+        for gi, u in enumerate(self.settings.gauss[0]):
+            c = (1.0 - u) * c0 + u * c1
+            big_r = np.sqrt(np.maximum(big_r0**2 - 0.5 * np.sum(c * c, axis=1), 0.0))
+            r = big_r[:, None] + c @ basis.T
+            dr = c @ slope.T
+            ds = np.sqrt(r * r + dr * dr)
+            width[:, gi] = np.sum(ds * in_contact[:, gi], axis=1) / np.sum(ds, axis=1)
+        emod = self.edge_modulus
+        d0 = 2.0 * self.edge_r0
+        press = self.penalty * emod[:, None, None] / d0[:, None, None] * pen
+        has = in_contact.any(axis=2)
+        mean_p = np.where(has, press.sum(axis=2) / np.maximum(in_contact.sum(axis=2), 1), 0.0)
+        g_w = np.asarray(self.settings.gauss[1])
+        area_s = self.edge_r0 * 2.0 * math.pi / ms  # rest area per unit rest length
+        f_len = area_s * np.einsum("egs,g->e", press, g_w)
+
+        def to_vertex(val: np.ndarray) -> np.ndarray:
+            out = np.zeros(n_v)
+            np.maximum.at(out, ev[:, 0], val)
+            np.maximum.at(out, ev[:, 1], val)
+            return out
+
+        stretch_v = np.zeros(n_v)
+        count = np.zeros(n_v)
+        for side in (0, 1):
+            np.add.at(stretch_v, ev[:, side], lam)
+            np.add.at(count, ev[:, side], 1.0)
+        stretch_v /= np.maximum(count, 1.0)
+        nu_v = np.zeros(n_v)
+        nu_v[ev[:, 0]] = self.edge_nu
+        nu_v[ev[:, 1]] = self.edge_nu
+        lc = to_vertex(width.max(axis=1))
+        return {"contact_width_fraction": lc,
+                "peak_pressure_over_E": to_vertex(press.max(axis=(1, 2)) / emod),
+                "mean_pressure_over_E": to_vertex(mean_p.max(axis=1) / emod),
+                "force_per_length": to_vertex(f_len),
+                "half_width": 0.25 * math.pi * to_vertex(d0) * lc,
+                "area_ratio": stretch_v ** (-2.0 * nu_v)}
+
+    # -- the energy term -----------------------------------------------------------------
+    def evaluate(self, x: np.ndarray, rest: np.ndarray, want_grad: bool = True,
+                 want_hess: bool = True):
+        """Not available: the sectioned level's energy needs its section dofs
+        (:meth:`evaluate_with_dofs`, which a :class:`tightknot.solvers.system.RodSystem`
+        calls)."""
+        raise TypeError("the sectioned contact level is evaluated with its section dofs "
+                        "(evaluate_with_dofs)")
+
+    def evaluate_with_dofs(self, x: np.ndarray, extra: np.ndarray,
+                           frames: tuple[np.ndarray, np.ndarray, np.ndarray],
+                           rest: np.ndarray, want_grad: bool, want_hess: bool):
+        """Section and contact energy [J] at positions ``x`` [m], vertex sections ``extra``
+        [m] and edge rest lengths ``rest`` [m], the sections carried in the accepted
+        ``frames`` (t_ref, d1_ref, m_ref); gradients over positions and coefficients;
+        Hessian COO over the extended dofs (rods/term.py)."""
+        extra = np.asarray(extra, dtype=np.float64)
+        rest = np.asarray(rest, dtype=np.float64)
+        e_s, g_s, h_s = self.section_energy(extra, frames[2], rest, want_grad, want_hess)
+        e_c, g_x, g_c, h_c = self.contact_energy(x, extra, frames, rest, want_grad, want_hess)
+        g_own = None if g_s is None else g_s + g_c
+        if want_hess:
+            self._add_coo(h_c, h_s)
+        return e_s + e_c, g_x, g_own, h_c
+
+
+def _rotate(c: np.ndarray, modes: np.ndarray, angle: np.ndarray, transpose: bool = False
+            ) -> np.ndarray:
+    """Rows of coefficients (E, K) turned by Q(angle) per row (Q^T with ``transpose``):
+    mode n by n angle (:func:`tightknot.contact.sectioned_reference.mode_rotation`)."""
+    ang = modes[None, :] * np.asarray(angle)[:, None]
+    cs, sn = np.cos(ang), np.sin(ang)
+    if transpose:
+        sn = -sn
+    a, b = c[:, 0::2], c[:, 1::2]
+    out = np.empty_like(c)
+    out[:, 0::2] = cs * a + sn * b
+    out[:, 1::2] = -sn * a + cs * b
+    return out

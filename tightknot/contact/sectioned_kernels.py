@@ -1,0 +1,829 @@
+"""Warp kernels of the sectioned level's contact between deformed sections.
+
+The formulation, the local dof order and what the Hessian leaves out are those of the NumPy
+oracle :mod:`tightknot.contact.sectioned_reference` (its module docstring). One thread
+evaluates one pass of one candidate pair: the boundary samples of its first edge A against
+the surface of its second edge B (thread 2 p: A = a, B = b; thread 2 p + 1: A = b, B = a).
+Each thread writes its energy and its gradient over the pass's local dofs (x_A0, x_A1,
+x_B0, x_B1, then the section coefficients of A's two vertices and of B's; L = 12 + 4 K for
+K coefficients per vertex) into its own slice of the outputs, and adds its Hessian into the
+dense blocks of the node pairs it couples (a node: a vertex with its 3 coordinates and K
+coefficients; the blocks' slots come with the pairs), which :mod:`tightknot.contact.
+sectioned` hands to the rod system.
+
+Per sample, every derivative over the L dofs is a combination of 16 reduced directions: the
+12 vertex coordinates and, for the sections, A's boundary at the sample's angle (along
+B(phi) + dR/dc, carried to A's two vertices by the interpolation weights), B's boundary at
+the angle psi facing the sample, its slope in psi, and the derivative of B's interpolation
+weights in the projection v. The per-sample Hessian is formed in those 16 directions and
+then expanded.
+
+Work is skipped where no contact can be: a Gauss circle of A whose axis point is farther
+from B's axis than the two sections' largest radii, and a sample farther from B's axis
+than B's largest radius (the bounds: the mean radius at the edge's stretch and the
+coefficients' absolute sums, which bound every boundary radius).
+
+Loops are not unrolled and no backward code is generated (derivatives are written by hand;
+local vectors are assigned in place), as in the compliant level's module.
+"""
+
+from __future__ import annotations
+
+import warp as wp
+
+f64 = wp.float64
+#: The most section coefficients per vertex the kernels hold (modes up to N = 12).
+MAX_COEFF = 22
+vecKd = wp.types.vector(length=MAX_COEFF, dtype=wp.float64)
+vec16d = wp.types.vector(length=16, dtype=wp.float64)
+mat16d = wp.types.matrix(shape=(16, 16), dtype=wp.float64)
+mat3x16d = wp.types.matrix(shape=(3, 16), dtype=wp.float64)
+vec6d = wp.types.vector(length=6, dtype=wp.float64)
+mat66d = wp.types.matrix(shape=(6, 6), dtype=wp.float64)
+mat36d = wp.types.matrix(shape=(3, 6), dtype=wp.float64)
+mat6x16d = wp.types.matrix(shape=(6, 16), dtype=wp.float64)
+
+wp.set_module_options({"max_unroll": 1, "enable_backward": False})
+
+TWO_PI = 6.283185307179586
+#: Relative step of the frames' second derivatives (sectioned_reference.FRAME_STEP).
+FRAME_STEP = 1.0e-6
+
+
+@wp.func
+def transported_frame(d1r: wp.vec3d, tr: wp.vec3d, t: wp.vec3d):
+    """d1 = P(tr -> t) d1r (Rodrigues' rotation taking unit tr onto unit t), d2 = t x d1,
+    and dd1/dt, dd2/dt with t a free 3-vector (sectioned_reference.transported_frame)."""
+    c = wp.dot(tr, t)
+    b = wp.cross(tr, t)
+    bu = wp.dot(b, d1r)
+    inv = f64(1.0) / (f64(1.0) + c)
+    d1 = c * d1r + wp.cross(b, d1r) + (bu * inv) * b
+    s = wp.skew(tr)
+    j1 = (wp.outer(d1r, tr) - wp.skew(d1r) @ s + inv * wp.outer(b, wp.transpose(s) @ d1r)
+          + (bu * inv) * s - (bu * inv * inv) * wp.outer(b, tr))
+    d2 = wp.cross(t, d1)
+    j2 = wp.skew(t) @ j1 - wp.skew(d1)
+    return d1, d2, j1, j2
+
+
+@wp.func
+def quintic(x: wp.float64) -> wp.vec3d:
+    """S(x) = x^3 (10 - 15 x + 6 x^2) on [0, 1], clamped, with S' and S''."""
+    if x <= f64(0.0):
+        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
+    if x >= f64(1.0):
+        return wp.vec3d(f64(1.0), f64(0.0), f64(0.0))
+    x2 = x * x
+    return wp.vec3d(x2 * x * (f64(10.0) - f64(15.0) * x + f64(6.0) * x2),
+                    f64(30.0) * x2 * (f64(1.0) - x) * (f64(1.0) - x),
+                    f64(60.0) * x * (f64(1.0) - x) * (f64(1.0) - f64(2.0) * x))
+
+
+@wp.func
+def partition_weight(v: wp.float64, first_open: int, last_open: int) -> wp.vec3d:
+    """omega(v), omega', omega'' (sectioned_reference.partition_weight)."""
+    if first_open != 0:
+        if v < f64(0.0):
+            s = quintic(f64(2.0) * v + f64(1.0))
+            return wp.vec3d(s[0], f64(2.0) * s[1], f64(4.0) * s[2])
+    elif v < f64(0.5):
+        return quintic(v + f64(0.5))
+    if last_open != 0:
+        if v > f64(1.0):
+            s = quintic(f64(2.0) * v - f64(2.0))
+            return wp.vec3d(f64(1.0) - s[0], f64(-2.0) * s[1], f64(-4.0) * s[2])
+    elif v > f64(0.5):
+        s = quintic(v - f64(0.5))
+        return wp.vec3d(f64(1.0) - s[0], -s[1], -s[2])
+    return wp.vec3d(f64(1.0), f64(0.0), f64(0.0))
+
+
+@wp.func
+def exclusion_weight(same_rod: int, closed: int, rod_length: wp.float64, s_a: wp.float64,
+                     arc_b: wp.vec2d, exclusion: wp.float64, v: wp.float64) -> wp.vec3d:
+    """W(v), dW/dv, d2W/dv2 of the exclusion ramp between arcs s_a and s_b(v) [m]
+    (sectioned_reference.exclusion_ramp)."""
+    if same_rod == 0:
+        return wp.vec3d(f64(1.0), f64(0.0), f64(0.0))
+    s_b = arc_b[0] + v * (arc_b[1] - arc_b[0])
+    dsep = s_b - s_a
+    sgn = f64(1.0)
+    if dsep < f64(0.0):
+        sgn = f64(-1.0)
+    sep = wp.abs(dsep)
+    if closed != 0:
+        if rod_length - sep < sep:
+            sep = rod_length - sep
+            sgn = -sgn
+    q = f64(0.25) * exclusion
+    s = quintic((sep - exclusion) / q)
+    dsdv = sgn * (arc_b[1] - arc_b[0]) / q
+    return wp.vec3d(s[0], s[1] * dsdv, s[2] * dsdv * dsdv)
+
+
+@wp.func
+def rounded_penalty(pen: wp.float64, kappa: wp.float64, onset: wp.float64) -> wp.vec3d:
+    """phi(pen), phi', phi'' (sectioned_reference.rounded_penalty)."""
+    if pen <= f64(0.0):
+        return wp.vec3d(f64(0.0), f64(0.0), f64(0.0))
+    if pen < onset:
+        return wp.vec3d(kappa * pen * pen * pen / (f64(6.0) * onset),
+                        kappa * pen * pen / (f64(2.0) * onset), kappa * pen / onset)
+    return wp.vec3d(kappa * (f64(0.5) * pen * pen - f64(0.5) * onset * pen
+                             + onset * onset / f64(6.0)),
+                    kappa * (pen - f64(0.5) * onset), kappa)
+
+
+@wp.func
+def mode_basis(phi: wp.float64, k: int):
+    """B(phi) and B'(phi) of the coefficients (a_2, b_2, ..., a_N, b_N), k = 2 (N - 1): cos n
+    phi, sin n phi and their derivatives, by the angle-addition recurrence."""
+    c1 = wp.cos(phi)
+    s1 = wp.sin(phi)
+    cn = c1 * c1 - s1 * s1  # n = 2
+    sn = f64(2.0) * s1 * c1
+    b = vecKd()
+    d = vecKd()
+    for j in range(k // 2):
+        n = f64(2 + j)
+        b[2 * j] = cn
+        b[2 * j + 1] = sn
+        d[2 * j] = -n * sn
+        d[2 * j + 1] = n * cn
+        cn_next = cn * c1 - sn * s1
+        sn = sn * c1 + cn * s1
+        cn = cn_next
+    return b, d
+
+
+@wp.func
+def load_section(coeff: wp.array(dtype=wp.float64), off: int, k: int) -> vecKd:
+    """The k coefficients from ``off`` (zero for a rigid section, off < 0)."""
+    c = vecKd()
+    if off >= 0:
+        for j in range(k):
+            c[j] = coeff[off + j]
+    return c
+
+
+@wp.func
+def rotate_modes(c: vecKd, angle: wp.float64, k: int, transpose: int) -> vecKd:
+    """Q(angle) c, or Q^T c (transpose != 0): mode n turned by n angle
+    (sectioned_reference.mode_rotation)."""
+    out = vecKd()
+    for j in range(k // 2):
+        n = f64(2 + j)
+        cs = wp.cos(n * angle)
+        sn = wp.sin(n * angle)
+        if transpose != 0:
+            sn = -sn
+        out[2 * j] = cs * c[2 * j] + sn * c[2 * j + 1]
+        out[2 * j + 1] = -sn * c[2 * j] + cs * c[2 * j + 1]
+    return out
+
+
+@wp.func
+def abs_sum(c: vecKd, k: int) -> wp.float64:
+    """sum |c_j| over the first k entries."""
+    t = f64(0.0)
+    for j in range(k):
+        t += wp.abs(c[j])
+    return t
+
+
+@wp.func
+def segment_line_distance(p0: wp.vec3d, p1: wp.vec3d, q0: wp.vec3d, e: wp.vec3d
+                          ) -> wp.float64:
+    """A lower bound of the distance [m] from segment p0 p1 to the segment q0 + v e,
+    v in [-1/2, 3/2] (the reach of a partner edge's partition weight): the distance of
+    their closest points (Ericson 2005 sec. 5.1.9, clamped)."""
+    d1 = p1 - p0
+    r = p0 - (q0 - f64(0.5) * e)
+    d2 = f64(2.0) * e
+    a = wp.dot(d1, d1)
+    ee = wp.dot(d2, d2)
+    f = wp.dot(d2, r)
+    c = wp.dot(d1, r)
+    b = wp.dot(d1, d2)
+    den = a * ee - b * b
+    s = f64(0.0)
+    if den > f64(1.0e-14) * a * ee:
+        s = wp.clamp((b * f - c * ee) / den, f64(0.0), f64(1.0))
+    t = (b * s + f) / ee
+    if t < f64(0.0):
+        t = f64(0.0)
+        s = wp.clamp(-c / a, f64(0.0), f64(1.0))
+    elif t > f64(1.0):
+        t = f64(1.0)
+        s = wp.clamp((b - c) / a, f64(0.0), f64(1.0))
+    return wp.length(p0 + s * d1 - (q0 - f64(0.5) * e + t * d2))
+
+
+@wp.struct
+class FrameDerivatives:
+    """An edge's transported frame with its derivatives in the edge vector e
+    (sectioned_reference.frame_derivatives): M = d(d)/de, and T, d2 d_k/de de for k = x, y,
+    z (central differences of M)."""
+
+    d1: wp.vec3d
+    d2: wp.vec3d
+    m1: wp.mat33d
+    m2: wp.mat33d
+    t1x: wp.mat33d
+    t1y: wp.mat33d
+    t1z: wp.mat33d
+    t2x: wp.mat33d
+    t2y: wp.mat33d
+    t2z: wp.mat33d
+
+
+@wp.func
+def frame_firsts(d1r: wp.vec3d, tr: wp.vec3d, e: wp.vec3d):
+    """d1, d2 and their exact derivatives in the edge vector e (3 x 3)."""
+    length = wp.length(e)
+    t = e / length
+    d1, d2, j1, j2 = transported_frame(d1r, tr, t)
+    pt = (wp.identity(n=3, dtype=wp.float64) - wp.outer(t, t)) / length
+    return d1, d2, j1 @ pt, j2 @ pt
+
+
+@wp.func
+def frame_derivatives(d1r: wp.vec3d, tr: wp.vec3d, e: wp.vec3d) -> FrameDerivatives:
+    """The frame and its first and second derivatives in e (FrameDerivatives)."""
+    out = FrameDerivatives()
+    d1, d2, m1, m2 = frame_firsts(d1r, tr, e)
+    out.d1 = d1
+    out.d2 = d2
+    out.m1 = m1
+    out.m2 = m2
+    h = f64(FRAME_STEP) * wp.length(e)
+    t1x = wp.mat33d()
+    t1y = wp.mat33d()
+    t1z = wp.mat33d()
+    t2x = wp.mat33d()
+    t2y = wp.mat33d()
+    t2z = wp.mat33d()
+    for j in range(3):
+        step = wp.vec3d()
+        step[j] = h
+        _p1, _p2, m1p, m2p = frame_firsts(d1r, tr, e + step)
+        _q1, _q2, m1m, m2m = frame_firsts(d1r, tr, e - step)
+        g1 = (m1p - m1m) / (f64(2.0) * h)
+        g2 = (m2p - m2m) / (f64(2.0) * h)
+        for i in range(3):
+            t1x[i, j] = g1[0, i]
+            t1y[i, j] = g1[1, i]
+            t1z[i, j] = g1[2, i]
+            t2x[i, j] = g2[0, i]
+            t2y[i, j] = g2[1, i]
+            t2z[i, j] = g2[2, i]
+    out.t1x = f64(0.5) * (t1x + wp.transpose(t1x))
+    out.t1y = f64(0.5) * (t1y + wp.transpose(t1y))
+    out.t1z = f64(0.5) * (t1z + wp.transpose(t1z))
+    out.t2x = f64(0.5) * (t2x + wp.transpose(t2x))
+    out.t2y = f64(0.5) * (t2y + wp.transpose(t2y))
+    out.t2z = f64(0.5) * (t2z + wp.transpose(t2z))
+    return out
+
+
+@wp.func
+def contract(y: wp.vec3d, tx: wp.mat33d, ty: wp.mat33d, tz: wp.mat33d) -> wp.mat33d:
+    """sum_k y_k T_k."""
+    return y[0] * tx + y[1] * ty + y[2] * tz
+
+
+@wp.func
+def join6(a: wp.vec3d, b: wp.vec3d) -> vec6d:
+    """(a, b)."""
+    return vec6d(a[0], a[1], a[2], b[0], b[1], b[2])
+
+
+@wp.func
+def add_block(m: mat66d, r0: int, c0: int, b: wp.mat33d) -> mat66d:
+    """m with b added at rows r0.., columns c0.."""
+    for i in range(3):
+        for j in range(3):
+            m[r0 + i, c0 + j] = m[r0 + i, c0 + j] + b[i, j]
+    return m
+
+
+@wp.struct
+class Cylinder:
+    """A point's projection v, distance rho and angle psi about an edge's axis, each with
+    gradient and Hessian over (w, e) = (P - x_b0, x_b1 - x_b0)
+    (sectioned_reference.cylinder_coordinates)."""
+
+    v: wp.float64
+    rho: wp.float64
+    psi: wp.float64
+    gv: vec6d
+    hv: mat66d
+    grho: vec6d
+    hrho: mat66d
+    gpsi: vec6d
+    hpsi: mat66d
+
+
+@wp.func
+def d2_dot(gv: vec6d, hv: mat66d, y: wp.vec3d, e: wp.vec3d) -> mat66d:
+    """y . d2 D over (w, e), D = w - v e: -(grad v y_e^T + y_e grad v^T) - (y . e) hess v."""
+    ye = join6(wp.vec3d(), y)
+    return -(wp.outer(gv, ye) + wp.outer(ye, gv)) - wp.dot(y, e) * hv
+
+
+@wp.func
+def frame_component(dvec: wp.vec3d, d: wp.vec3d, m: wp.mat33d, tx: wp.mat33d,
+                    ty: wp.mat33d, tz: wp.mat33d, jd: mat36d, gv: vec6d, hv: mat66d,
+                    e: wp.vec3d):
+    """X = D . d over (w, e): value, gradient and Hessian, d the frame vector with
+    derivative m and second derivatives T in e."""
+    dm = mat36d()
+    for i in range(3):
+        for j in range(3):
+            dm[i, 3 + j] = m[i, j]
+    grad = wp.transpose(jd) @ d + wp.transpose(dm) @ dvec
+    hess = d2_dot(gv, hv, d, e) + wp.transpose(jd) @ dm + wp.transpose(dm) @ jd
+    hess = add_block(hess, 3, 3, contract(dvec, tx, ty, tz))
+    return wp.dot(dvec, d), grad, hess
+
+
+@wp.func
+def cylinder(w: wp.vec3d, e: wp.vec3d, fd: FrameDerivatives) -> Cylinder:
+    """Cylinder coordinates of w about e with their derivatives (Cylinder)."""
+    out = Cylinder()
+    ll = wp.dot(e, e)
+    v = wp.dot(w, e) / ll
+    dvec = w - v * e
+    rho = wp.length(dvec)
+    nrm = dvec / rho
+    a = w - f64(2.0) * v * e
+    gv = join6(e / ll, a / ll)
+    eye = wp.identity(n=3, dtype=wp.float64)
+    hv = mat66d()
+    hv = add_block(hv, 0, 3, eye / ll - f64(2.0) * wp.outer(e, e) / (ll * ll))
+    hv = add_block(hv, 3, 0, eye / ll - f64(2.0) * wp.outer(e, e) / (ll * ll))
+    hv = add_block(hv, 3, 3, f64(-2.0) * (wp.outer(e, a) + wp.outer(a, e)) / (ll * ll)
+                   - (f64(2.0) * v / ll) * eye)
+    jd = mat36d()
+    left = eye - wp.outer(e, e) / ll
+    right = -v * eye - wp.outer(e, a) / ll
+    for i in range(3):
+        for j in range(3):
+            jd[i, j] = left[i, j]
+            jd[i, 3 + j] = right[i, j]
+    out.v = v
+    out.rho = rho
+    out.gv = gv
+    out.hv = hv
+    out.grho = wp.transpose(jd) @ nrm
+    out.hrho = (wp.transpose(jd) @ (((eye - wp.outer(nrm, nrm)) / rho) @ jd)
+                + d2_dot(gv, hv, nrm, e))
+    x, gx, hx = frame_component(dvec, fd.d1, fd.m1, fd.t1x, fd.t1y, fd.t1z, jd, gv, hv, e)
+    y, gy, hy = frame_component(dvec, fd.d2, fd.m2, fd.t2x, fd.t2y, fd.t2z, jd, gv, hv, e)
+    ss = x * x + y * y
+    out.psi = wp.atan2(y, x)
+    out.gpsi = (x * gy - y * gx) / ss
+    # psi = Im log(X + i Y): its Hessian is Im(hess Z / Z - grad Z grad Z^T / Z^2).
+    out.hpsi = ((x * hy - y * hx) / ss
+                - ((wp.outer(gx, gx) - wp.outer(gy, gy)) * (f64(-2.0) * x * y)
+                   + (wp.outer(gx, gy) + wp.outer(gy, gx)) * (x * x - y * y)) / (ss * ss))
+    return out
+
+
+@wp.func
+def radius_partials(c: vecKd, k: int, rigid: int, r0: wp.float64, nu: wp.float64,
+                    lam: wp.float64):
+    """R, dR/dlam and d2R/dlam2 where the coefficients are c (r0, 0, 0 for a rigid
+    section; R = -1 where it is not real)."""
+    if rigid != 0:
+        return r0, f64(0.0), f64(0.0)
+    s = r0 * r0 * wp.pow(lam, f64(-2.0) * nu)
+    for j in range(k):
+        s -= f64(0.5) * c[j] * c[j]
+    if s <= f64(0.0):
+        return f64(-1.0), f64(0.0), f64(0.0)
+    big_r = wp.sqrt(s)
+    s1 = f64(-2.0) * nu * r0 * r0 * wp.pow(lam, f64(-2.0) * nu - f64(1.0))
+    s2 = f64(2.0) * nu * (f64(2.0) * nu + f64(1.0)) * r0 * r0 * wp.pow(lam, f64(-2.0) * nu
+                                                                      - f64(2.0))
+    return big_r, s1 / (f64(2.0) * big_r), (s2 / (f64(2.0) * big_r)
+                                            - s1 * s1 / (f64(4.0) * big_r * big_r * big_r))
+
+
+@wp.func
+def add_pee(target: mat16d, pee: wp.mat33d, row: wp.vec3d, deform_a: int) -> mat16d:
+    """target with the second derivatives of P in a's edge vector (``pee``, on x_A0 and
+    x_A1 with the signs of e = x_A1 - x_A0) and their coupling ``row`` to a's section
+    direction (index 12) added."""
+    for i in range(3):
+        for j in range(3):
+            target[3 + i, 3 + j] = target[3 + i, 3 + j] + pee[i, j]
+            target[i, j] = target[i, j] + pee[i, j]
+            target[i, 3 + j] = target[i, 3 + j] - pee[i, j]
+            target[3 + i, j] = target[3 + i, j] - pee[i, j]
+        if deform_a != 0:
+            target[3 + i, 12] = target[3 + i, 12] + row[i]
+            target[12, 3 + i] = target[12, 3 + i] + row[i]
+            target[i, 12] = target[i, 12] - row[i]
+            target[12, i] = target[12, i] - row[i]
+    return target
+
+
+def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
+    """The pass kernel's variant: energy only, or with the gradient and Hessian
+    (``derivatives``); ``report`` also writes each sample's penetration and weight."""
+
+    def sectioned_pass(
+        # Model:
+        edge_vertex: wp.array(dtype=wp.vec2i),
+        edge_rod: wp.array(dtype=wp.int32),
+        rod_closed: wp.array(dtype=wp.int32),
+        edge_r0: wp.array(dtype=wp.float64),
+        edge_nu: wp.array(dtype=wp.float64),
+        edge_modulus: wp.array(dtype=wp.float64),
+        edge_rigid: wp.array(dtype=wp.int32),
+        vertex_offset: wp.array(dtype=wp.int32),
+        edge_end: wp.array(dtype=wp.vec2i),
+        edge_exclusion: wp.array(dtype=wp.float64),
+        gauss_xi: wp.array(dtype=wp.float64),
+        gauss_w: wp.array(dtype=wp.float64),
+        coeff_count: int,
+        samples: int,
+        penalty: wp.float64,
+        onset: wp.float64,
+        # Data in:
+        x_in: wp.array(dtype=wp.vec3d),
+        coeff_in: wp.array(dtype=wp.float64),
+        t_ref_in: wp.array(dtype=wp.vec3d),
+        d1_ref_in: wp.array(dtype=wp.vec3d),
+        end_twist_in: wp.array(dtype=wp.float64),
+        rest_in: wp.array(dtype=wp.float64),
+        arc_in: wp.array(dtype=wp.vec2d),
+        rod_length_in: wp.array(dtype=wp.float64),
+        pairs_in: wp.array(dtype=wp.vec2i),
+        slots_in: wp.array(dtype=wp.int32),
+        # Out:
+        energy_out: wp.array(dtype=wp.float64),
+        pen_max_out: wp.array(dtype=wp.float64),
+        grad_out: wp.array(dtype=wp.float64),
+        blocks_out: wp.array(dtype=wp.float64),
+        sample_pen_out: wp.array(dtype=wp.float64),
+        sample_weight_out: wp.array(dtype=wp.float64),
+    ):
+        tid = wp.tid()
+        pr = pairs_in[tid // 2]
+        ea = pr[0]
+        eb = pr[1]
+        if tid % 2 == 1:
+            ea = pr[1]
+            eb = pr[0]
+        k = coeff_count
+        nl = 12 + 4 * k
+        ng = gauss_xi.shape[0]
+        so = tid * ng * samples
+        if wp.static(report):
+            for q in range(ng * samples):
+                sample_pen_out[so + q] = f64(0.0)
+                sample_weight_out[so + q] = f64(0.0)
+        energy = f64(0.0)
+        pen_max = f64(-1.0e30)
+        va = edge_vertex[ea]
+        vb = edge_vertex[eb]
+        xa0 = x_in[va[0]]
+        xb0 = x_in[vb[0]]
+        vec_a = x_in[va[1]] - xa0
+        vec_b = x_in[vb[1]] - xb0
+        la = wp.length(vec_a)
+        lb = wp.length(vec_b)
+        ta = vec_a / la
+        tb = vec_b / lb
+        rig_a = edge_rigid[ea]
+        rig_b = edge_rigid[eb]
+        # The sections of the edges' vertices, the second one's in the edge's frame.
+        ca0 = load_section(coeff_in, vertex_offset[va[0]], k)
+        ca1 = rotate_modes(load_section(coeff_in, vertex_offset[va[1]], k), end_twist_in[ea],
+                           k, 1)
+        cb0 = load_section(coeff_in, vertex_offset[vb[0]], k)
+        cb1 = rotate_modes(load_section(coeff_in, vertex_offset[vb[1]], k), end_twist_in[eb],
+                           k, 1)
+        lam_a = la / rest_in[ea]
+        lam_b = lb / rest_in[eb]
+        # Largest boundary radii: the mean radius is at most r0 lam^-nu, and over the
+        # partner's reach (v in [-1/2, 3/2]) |c(v)| sums to at most 1.5 (|c_0| + |c_1|).
+        r_a_max = edge_r0[ea] * wp.pow(lam_a, -edge_nu[ea]) + wp.max(abs_sum(ca0, k),
+                                                                     abs_sum(ca1, k))
+        r_b_max = edge_r0[eb] * wp.pow(lam_b, -edge_nu[eb]) + f64(1.5) * (abs_sum(cb0, k)
+                                                                         + abs_sum(cb1, k))
+        if rig_a != 0:
+            r_a_max = edge_r0[ea]
+        if rig_b != 0:
+            r_b_max = edge_r0[eb]
+        if segment_line_distance(xa0, x_in[va[1]], xb0, vec_b) > r_a_max + r_b_max:
+            energy_out[tid] = energy
+            pen_max_out[tid] = pen_max
+            return
+        if wp.static(derivatives):
+            fa = frame_derivatives(d1_ref_in[ea], t_ref_in[ea], vec_a)
+            fb = frame_derivatives(d1_ref_in[eb], t_ref_in[eb], vec_b)
+            d1a = fa.d1
+            d2a = fa.d2
+            d1b = fb.d1
+            d2b = fb.d2
+        else:
+            d1a, d2a, _j1a, _j2a = transported_frame(d1_ref_in[ea], t_ref_in[ea], ta)
+            d1b, d2b, _j1b, _j2b = transported_frame(d1_ref_in[eb], t_ref_in[eb], tb)
+        eye = wp.identity(n=3, dtype=wp.float64)
+        emod = f64(2.0) * edge_modulus[ea] * edge_modulus[eb] / (edge_modulus[ea]
+                                                                  + edge_modulus[eb])
+        d0 = edge_r0[ea] + edge_r0[eb]
+        kappa = penalty * emod / d0
+        onset_m = onset * d0
+        rod = edge_rod[ea]
+        same_rod = int(0)
+        if edge_rod[eb] == rod:
+            same_rod = 1
+        closed = rod_closed[rod]
+        rod_len = rod_length_in[rod]
+        excl = wp.max(edge_exclusion[ea], edge_exclusion[eb])
+        arc_a = arc_in[ea]
+        arc_b = arc_in[eb]
+        endb = edge_end[eb]
+        area = rest_in[ea] * edge_r0[ea] * f64(TWO_PI) / f64(samples)
+        dcb = cb1 - cb0  # dc_b/dv
+        mta = end_twist_in[ea]
+        mtb = end_twist_in[eb]
+        go = tid * nl
+        for gi in range(ng):
+            u = gauss_xi[gi]
+            xu = xa0 + u * vec_a
+            # the Gauss circle cannot reach B
+            rel0 = xu - xb0
+            v0 = wp.dot(rel0, vec_b) / (lb * lb)
+            v0c = wp.clamp(v0, f64(-0.5), f64(1.5))
+            if wp.length(rel0 - v0c * vec_b) > r_a_max + r_b_max:
+                continue
+            ca = (f64(1.0) - u) * ca0 + u * ca1
+            ra_mean, ra_l, ra_ll = radius_partials(ca, k, rig_a, edge_r0[ea], edge_nu[ea],
+                                                   lam_a)
+            if ra_mean <= f64(0.0):
+                energy_out[tid] = f64(1.0e300)
+                pen_max_out[tid] = pen_max
+                return
+            s_a = arc_a[0] + u * (arc_a[1] - arc_a[0])
+            for kk in range(samples):
+                phi = f64(TWO_PI) * (f64(kk) + f64(0.5)) / f64(samples)
+                cphi = wp.cos(phi)
+                sphi = wp.sin(phi)
+                bphi, bphi1 = mode_basis(phi, k)
+                r_a = ra_mean
+                if rig_a == 0:
+                    r_a += wp.dot(bphi, ca)
+                dirv = cphi * d1a + sphi * d2a
+                p = xu + r_a * dirv
+                rel = p - xb0
+                v = wp.dot(rel, vec_b) / (lb * lb)
+                if v < f64(-0.5) or v > f64(1.5):
+                    continue
+                dvec = rel - v * vec_b
+                rho = wp.length(dvec)
+                if rho >= r_b_max:
+                    continue
+                bx = wp.dot(dvec, d1b)
+                by = wp.dot(dvec, d2b)
+                psi = wp.atan2(by, bx)
+                bpsi, bpsi1 = mode_basis(psi, k)
+                cb = (f64(1.0) - v) * cb0 + v * cb1
+                rb_mean, rb_l, rb_ll = radius_partials(cb, k, rig_b, edge_r0[eb], edge_nu[eb],
+                                                       lam_b)
+                if rb_mean <= f64(0.0):
+                    energy_out[tid] = f64(1.0e300)
+                    pen_max_out[tid] = pen_max
+                    return
+                r_b = rb_mean
+                r_b1 = f64(0.0)
+                r_b2 = f64(0.0)
+                if rig_b == 0:
+                    r_b += wp.dot(bpsi, cb)
+                    r_b1 = wp.dot(bpsi1, cb)
+                    for j in range(k // 2):
+                        n2 = f64((2 + j) * (2 + j))
+                        r_b2 -= n2 * (bpsi[2 * j] * cb[2 * j] + bpsi[2 * j + 1] * cb[2 * j + 1])
+                pen = r_b - rho
+                om = partition_weight(v, endb[0], endb[1])
+                wex = exclusion_weight(same_rod, closed, rod_len, s_a, arc_b, excl, v)
+                wt = om[0] * wex[0]
+                if wt > f64(0.0):
+                    pen_max = wp.max(pen_max, pen)
+                if wp.static(report):
+                    sample_pen_out[so + gi * samples + kk] = pen
+                    sample_weight_out[so + gi * samples + kk] = wt
+                if pen <= f64(0.0) or wt <= f64(0.0):
+                    continue
+                ph = rounded_penalty(pen, kappa, onset_m)
+                a_s = f64(0.5) * gauss_w[gi] * area
+                energy += a_s * wt * ph[0]
+                if wp.static(derivatives):
+                    wt1 = om[1] * wex[0] + om[0] * wex[1]
+                    wt2 = om[2] * wex[0] + f64(2.0) * om[1] * wex[1] + om[0] * wex[2]
+                    cyl = cylinder(rel, vec_b, fb)
+                    # dr/dc at the sample on each side, and B's radius partials in (psi, v)
+                    ba = bphi - ca / (f64(2.0) * ra_mean)
+                    bb = bpsi - cb / (f64(2.0) * rb_mean)
+                    rbv = f64(0.0)
+                    rbvv = f64(0.0)
+                    rbpsiv = f64(0.0)
+                    if rig_b == 0:
+                        rbv = wp.dot(bb, dcb)
+                        rbvv = (-wp.dot(dcb, dcb) / (f64(2.0) * rb_mean)
+                                - wp.dot(cb, dcb) * wp.dot(cb, dcb)
+                                / (f64(4.0) * rb_mean * rb_mean * rb_mean))
+                        rbpsiv = wp.dot(bpsi1, dcb)
+                    # P over the reduced directions: x_A0, x_A1 and A's section direction
+                    m_dir = cphi * fa.m1 + sphi * fa.m2
+                    dra = (ra_l / rest_in[ea]) * ta
+                    dp_de = u * eye + r_a * m_dir + wp.outer(dirv, dra)
+                    jr = mat6x16d()
+                    for i in range(3):
+                        for j in range(3):
+                            jr[i, j] = eye[i, j] - dp_de[i, j]
+                            jr[i, 3 + j] = dp_de[i, j]
+                            jr[i, 6 + j] = -eye[i, j]
+                            jr[3 + i, 6 + j] = -eye[i, j]
+                            jr[3 + i, 9 + j] = eye[i, j]
+                        if rig_a == 0:
+                            jr[i, 12] = dirv[i]
+                    lam_dir = join6(wp.vec3d(), tb / rest_in[eb])
+                    lam_hess = add_block(mat66d(), 3, 3, (eye - wp.outer(tb, tb))
+                                         / (lb * rest_in[eb]))
+                    gpsi = cyl.gpsi
+                    gv = cyl.gv
+                    g_we = cyl.grho - r_b1 * gpsi - rbv * gv - rb_l * lam_dir
+                    h_we = (cyl.hrho - r_b2 * wp.outer(gpsi, gpsi) - r_b1 * cyl.hpsi
+                            - rbvv * wp.outer(gv, gv) - rbv * cyl.hv
+                            - rbpsiv * (wp.outer(gpsi, gv) + wp.outer(gv, gpsi))
+                            - rb_ll * wp.outer(lam_dir, lam_dir) - rb_l * lam_hess)
+                    r_g = wp.transpose(jr) @ g_we
+                    r_v = wp.transpose(jr) @ gv
+                    r_psi = wp.transpose(jr) @ gpsi
+                    hg = wp.transpose(jr) @ (h_we @ jr)
+                    hvr = wp.transpose(jr) @ (cyl.hv @ jr)
+                    if rig_b == 0:
+                        r_g[13] = r_g[13] - f64(1.0)
+                        for c in range(16):
+                            hg[c, 14] = hg[c, 14] - r_psi[c]
+                            hg[14, c] = hg[14, c] - r_psi[c]
+                            hg[c, 15] = hg[c, 15] - r_v[c]
+                            hg[15, c] = hg[15, c] - r_v[c]
+                    # P's own second derivatives in A's edge vector, contracted with dg/dw
+                    # and dv/dw
+                    hra = ((ra_ll / (rest_in[ea] * rest_in[ea])) * wp.outer(ta, ta)
+                           + (ra_l / (la * rest_in[ea])) * (eye - wp.outer(ta, ta)))
+                    for side in range(2):
+                        gw = wp.vec3d(g_we[0], g_we[1], g_we[2])
+                        if side == 1:
+                            gw = wp.vec3d(gv[0], gv[1], gv[2])
+                        row = wp.transpose(m_dir) @ gw
+                        pee = (r_a * (cphi * contract(gw, fa.t1x, fa.t1y, fa.t1z)
+                                      + sphi * contract(gw, fa.t2x, fa.t2y, fa.t2z))
+                               + wp.outer(row, dra) + wp.outer(dra, row) + wp.dot(gw, dirv) * hra)
+                        if side == 0:
+                            hg = add_pee(hg, pee, row, 1 - rig_a)
+                        else:
+                            hvr = add_pee(hvr, pee, row, 1 - rig_a)
+                    r_grad = a_s * (-wt * ph[1] * r_g + ph[0] * wt1 * r_v)
+                    h = (wt * ph[2]) * wp.outer(r_g, r_g) - (wt * ph[1]) * hg
+                    h -= (ph[1] * wt1) * (wp.outer(r_g, r_v) + wp.outer(r_v, r_g))
+                    h += ph[0] * (wt2 * wp.outer(r_v, r_v) + wt1 * hvr)
+                    h = a_s * h
+                    expand(h, r_grad, u, v, ba, bb, bpsi1, mta, mtb, k, go, tid, rig_a,
+                           rig_b, grad_out, slots_in, blocks_out)
+        energy_out[tid] = energy
+        pen_max_out[tid] = pen_max
+
+    key = f"sectioned_pass_d{int(derivatives)}_r{int(report)}"
+    return wp.Kernel(sectioned_pass, key=key, module=wp.get_module(__name__))
+
+
+@wp.func
+def node_row(h: mat16d, n: int, l: int, j: int, wa: vecKd, wb: vecKd, wg: vecKd,
+             wd: vecKd) -> vec16d:
+    """Row e^T h of the reduced Hessian for local dof ``l`` of node ``n`` (0, 1: A's
+    vertices, 2, 3: B's): a coordinate (l < 3) is reduced direction 3 n + l; a section
+    coefficient j = l - 3 is A's direction 12 times ``wa[j]``, or B's 13, 14, 15 times
+    ``wb[j]``, ``wg[j]``, ``wd[j]``."""
+    out = vec16d()
+    if l < 3:
+        for c in range(16):
+            out[c] = h[3 * n + l, c]
+    elif n < 2:
+        for c in range(16):
+            out[c] = wa[j] * h[12, c]
+    else:
+        for c in range(16):
+            out[c] = wb[j] * h[13, c] + wg[j] * h[14, c] + wd[j] * h[15, c]
+    return out
+
+
+@wp.func
+def node_dot(r: vec16d, n: int, l: int, j: int, wa: vecKd, wb: vecKd, wg: vecKd,
+             wd: vecKd) -> wp.float64:
+    """r . e for local dof ``l`` of node ``n`` (node_row's directions)."""
+    if l < 3:
+        return r[3 * n + l]
+    if n < 2:
+        return r[12] * wa[j]
+    return r[13] * wb[j] + r[14] * wg[j] + r[15] * wd[j]
+
+
+@wp.func
+def expand(h: mat16d, r_grad: vec16d, u: wp.float64, v: wp.float64, ba: vecKd, bb: vecKd,
+           bs: vecKd, mta: wp.float64, mtb: wp.float64, k: int, go: int, tid: int,
+           rig_a: int, rig_b: int, grad_out: wp.array(dtype=wp.float64),
+           slots: wp.array(dtype=wp.int32), blocks: wp.array(dtype=wp.float64)):
+    """Add a sample's reduced gradient and Hessian to the pass's gradient and to its
+    node-pair blocks (nodes A0, A1, B0, B1; each with 3 coordinates and k coefficients).
+    The section directions are carried to the vertices: alpha (``ba``) by (1 - u) and u Q
+    to A's, beta (``bb``) and gamma (``bs``) by (1 - v) and v Q to B's, delta (``bb``) by
+    -1 and Q to B's. Pair p's blocks are ``slots[16 p + 4 n_i + n_j]`` with its nodes in
+    (a0, a1, b0, b1) order (pass 1 has A = b: its node n is the pair's (n + 2) % 4)."""
+    bsz = 3 + k
+    qa = rotate_modes(ba, mta, k, 0)
+    qb = rotate_modes(bb, mtb, k, 0)
+    qs = rotate_modes(bs, mtb, k, 0)
+    zero = vecKd()
+    for i in range(12):
+        grad_out[go + i] = grad_out[go + i] + r_grad[i]
+    for j in range(k):
+        if rig_a == 0:
+            grad_out[go + 12 + j] = grad_out[go + 12 + j] + r_grad[12] * (f64(1.0) - u) * ba[j]
+            grad_out[go + 12 + k + j] = grad_out[go + 12 + k + j] + r_grad[12] * u * qa[j]
+        if rig_b == 0:
+            grad_out[go + 12 + 2 * k + j] = (grad_out[go + 12 + 2 * k + j]
+                                             + r_grad[13] * (f64(1.0) - v) * bb[j])
+            grad_out[go + 12 + 3 * k + j] = grad_out[go + 12 + 3 * k + j] + r_grad[13] * v * qb[j]
+    pair = tid // 2
+    for n in range(4):
+        rig_n = rig_a
+        if n >= 2:
+            rig_n = rig_b
+        # the node's section weights on the reduced directions
+        wa = zero
+        wb = zero
+        wg = zero
+        wd = zero
+        if n == 0:
+            wa = (f64(1.0) - u) * ba
+        elif n == 1:
+            wa = u * qa
+        elif n == 2:
+            wb = (f64(1.0) - v) * bb
+            wg = (f64(1.0) - v) * bs
+            wd = -bb
+        else:
+            wb = v * qb
+            wg = v * qs
+            wd = qb
+        rows = 3
+        if rig_n == 0:
+            rows = bsz
+        for l in range(rows):
+            r = node_row(h, n, l, l - 3, wa, wb, wg, wd)
+            for m in range(4):
+                rig_m = rig_a
+                if m >= 2:
+                    rig_m = rig_b
+                ma = zero
+                mb = zero
+                mg = zero
+                md = zero
+                if m == 0:
+                    ma = (f64(1.0) - u) * ba
+                elif m == 1:
+                    ma = u * qa
+                elif m == 2:
+                    mb = (f64(1.0) - v) * bb
+                    mg = (f64(1.0) - v) * bs
+                    md = -bb
+                else:
+                    mb = v * qb
+                    mg = v * qs
+                    md = qb
+                ni = n
+                nj = m
+                if tid % 2 == 1:
+                    ni = (n + 2) % 4
+                    nj = (m + 2) % 4
+                base = (slots[pair * 16 + ni * 4 + nj] * bsz + l) * bsz
+                cols = 3
+                if rig_m == 0:
+                    cols = bsz
+                for l2 in range(cols):
+                    val = node_dot(r, m, l2, l2 - 3, ma, mb, mg, md)
+                    wp.atomic_add(blocks, base + l2, val)
+
+
+#: The variants: energy only, energy with derivatives, energy with the samples' report.
+ENERGY = make_pass_kernel(False, False)
+DERIVATIVES = make_pass_kernel(True, False)
+REPORT = make_pass_kernel(False, True)

@@ -1,0 +1,250 @@
+"""The FEM's indent and wrap scenes with the rod model at the sectioned contact level.
+
+The scenes, load levels and boundary conditions of :mod:`tightknot.fem.rod_model`, with the
+contact of :class:`tightknot.contact.sectioned.SectionedLayer`: the compared rod carries its
+sections as dofs, the rigid counter-bodies are pinned rods with rigid round sections
+(``rigid_rods``), so that no pair law needs scaling. Each level reports the keys of the
+compliant level's runs (force, A/A0 and peak pressure at the mid section, the wrap's line
+load and curvature) and, read off the sections, the contact width fraction L_c of the mid
+section.
+
+The wrap's axis: as in the FEM (:func:`tightknot.fem.scenes.wrap.nominal_axis`), the far
+fibre (the boundary point opposite the contact, here the mid section's deformed boundary
+at the angle facing away from the cylinder) moved toward the cylinder by the stretched
+radius r0 lambda^(-1/2); line load per length and curvature are taken on it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from .material import ROD_DIAMETER, YOUNGS_MODULUS
+from .rod_model import DENSITY, EDGES_PER_D0, _line_points, _solve_levels, wrap_constraints
+
+
+def _layer(model: Any, section: Any, rigid_rods: tuple[int, ...]) -> Any:
+    from tightknot.contact.sectioned import SectionedLayer
+
+    return SectionedLayer(model, section, rigid_rods=rigid_rods, gauss_points=2)
+
+
+def _report(layer: Any, system: Any) -> dict[str, np.ndarray]:
+    st = system.state
+    return layer.section_report(st.x, st.extra, (st.t_ref, st.d1_ref, st.m_ref), system.rest)
+
+
+def _contact_gradient(layer: Any, system: Any) -> np.ndarray:
+    """The contact's gradient over positions [N] (vertex_count, 3) at the state."""
+    st = system.state
+    return layer.contact_energy(st.x, st.extra, (st.t_ref, st.d1_ref, st.m_ref), system.rest,
+                                True, False)[1]
+
+
+def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
+                         youngs_modulus: float = YOUNGS_MODULUS, length_over_d0: float = 3.0,
+                         section: Any = None) -> dict[str, Any]:
+    """The indent scene (:func:`tightknot.fem.rod_model.rod_indent`) at the sectioned
+    level (``section``: its :class:`~tightknot.contact.sectioned.SectionSettings`). Per
+    level: ``force`` [N] on the upper indenter, ``area_ratio_mid``, ``peak_pressure_over_e``,
+    ``contact_width_fraction_mid`` (both indenters' contacts), ``axial_stretch_mid``."""
+    from tightknot.loading.levels import LevelLoad
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    start = time.perf_counter()
+    d0 = diameter
+    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod += n_rod % 2  # even: a vertex at z = 0
+    n_obs = 4 * EDGES_PER_D0
+    half = 0.5 * length_over_d0 * d0
+    mat = Material(youngs_modulus, 0.5, DENSITY)
+    b = RodBuilder(twist=False)
+    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
+    for sign in (1.0, -1.0):  # indenters above and below, touching at rest
+        b.add_rod(_line_points(np.array([-2 * d0, sign * d0, 0]),
+                               np.array([2 * d0, sign * d0, 0]), n_obs), d0, mat)
+    model = b.finalize()
+    load = LevelLoad()
+    bcs = BoundaryConditions(model)
+    for rod, sign in ((1, 1.0), (2, -1.0)):
+        for k in range(n_obs + 1):
+            bcs.pin(rod, k, translation=lambda t, s=sign: np.array([0.0, -s * load(t), 0.0]))
+    mid = n_rod // 2
+    for k in range(n_rod + 1):
+        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
+    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
+    bcs.fix_components(0, 0, (1,))  # rigid tilt about x is force-free: gauged at the ends
+    bcs.fix_components(0, -1, (1,))
+    system = RodSystem(model, State.initial(model), bcs)
+    layer = _layer(model, section, (1, 2))
+    system.add_term(layer)
+    up_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+    rod_v0 = model.rods[0].vertex_start
+
+    def measure(w: float) -> dict[str, Any]:
+        x = system.state.x
+        force = -float(_contact_gradient(layer, system)[up_v, 1].sum())
+        rep = _report(layer, system)
+        e = np.linalg.norm(np.diff(x[rod_v0:rod_v0 + n_rod + 1], axis=0), axis=1)
+        stretch = float(0.5 * (e[mid - 1] + e[mid]) / (2.0 * half / n_rod))
+        v = rod_v0 + mid
+        return {
+            "w_over_d0": w / d0, "approach_over_d0": 2.0 * w / d0, "force": force,
+            "force_over_e_d0sq": force / (youngs_modulus * d0**2),
+            "axial_stretch_mid": stretch, "area_ratio_mid": float(rep["area_ratio"][v]),
+            "peak_pressure_over_e": float(rep["peak_pressure_over_E"][v]),
+            "contact_width_fraction_mid": float(rep["contact_width_fraction"][v]),
+        }
+
+    rows = _solve_levels(system, load, list(w_levels), measure)
+    return {"steps": rows, "wall_time_s": time.perf_counter() - start,
+            "vertices": int(model.vertex_count), "contact": "sectioned",
+            "section_modes": layer.section.max_mode, "penalty": layer.penalty}
+
+
+def _far_fibre_axis(layer: Any, system: Any, verts: np.ndarray, axis_y: float,
+                    r_stretched: float) -> np.ndarray:
+    """The nominal axis at vertices ``verts`` of the wrapped rod (module docstring): the
+    far fibre, opposite the direction to the cylinder axis (the line y = ``axis_y``, z = 0
+    along x), moved toward it by ``r_stretched`` [m]."""
+    from tightknot.contact.sectioned_reference import mode_basis
+
+    st = system.state
+    m = layer.model
+    k = layer.section.coeff_count
+    out = np.empty((len(verts), 3))
+    last_edge = m.rods[0].edge_start + m.rods[0].edge_count - 1
+    for i, v in enumerate(verts):
+        e = min(v - m.rods[0].vertex_start + m.rods[0].edge_start, last_edge)
+        t, d1 = st.t_ref[e], st.d1_ref[e]
+        d2 = np.cross(t, d1)
+        # the direction to the cylinder's axis (the x axis at y = axis_y), normal to t
+        toward = np.array([0.0, axis_y - st.x[v, 1], -st.x[v, 2]])
+        toward -= (toward @ t) * t
+        away = -toward / np.linalg.norm(toward)
+        phi = math.atan2(away @ d2, away @ d1)
+        c = st.extra[layer.vertex_offset[v]:layer.vertex_offset[v] + k]
+        a, b = m.edge_vertex[e]
+        lam = float(np.linalg.norm(st.x[b] - st.x[a]) / system.rest[e])
+        big_r = math.sqrt(layer.edge_r0[e] ** 2 / lam - 0.5 * float(c @ c))
+        r = big_r + float(mode_basis(layer.modes, np.array([phi]))[0][0] @ c)
+        out[i] = st.x[v] + (r - r_stretched) * away
+    return out
+
+
+def _centroid_axis(layer: Any, system: Any, verts: np.ndarray) -> np.ndarray:
+    """The centroids [m] of the deformed sections at vertices ``verts`` of rod 0: the
+    centre x_v plus (1 / 3A) int r^3 (cos phi d1 + sin phi d2) dphi, A = (1/2) int r^2 dphi
+    (the area centroid of a star-shaped section), by the midpoint rule on 720 angles."""
+    from tightknot.contact.sectioned_reference import mode_basis
+
+    st = system.state
+    m = layer.model
+    k = layer.section.coeff_count
+    phi = 2.0 * math.pi * (np.arange(720) + 0.5) / 720
+    basis = mode_basis(layer.modes, phi)[0]
+    last_edge = m.rods[0].edge_start + m.rods[0].edge_count - 1
+    out = np.empty((len(verts), 3))
+    for i, v in enumerate(verts):
+        e = min(v - m.rods[0].vertex_start + m.rods[0].edge_start, last_edge)
+        t, d1 = st.t_ref[e], st.d1_ref[e]
+        d2 = np.cross(t, d1)
+        c = st.extra[layer.vertex_offset[v]:layer.vertex_offset[v] + k]
+        a, b = m.edge_vertex[e]
+        lam = float(np.linalg.norm(st.x[b] - st.x[a]) / system.rest[e])
+        r = math.sqrt(layer.edge_r0[e] ** 2 / lam - 0.5 * float(c @ c)) + basis @ c
+        area = 0.5 * float(np.mean(r * r)) * 2.0 * math.pi
+        mx = float(np.mean(r**3 * np.cos(phi))) * 2.0 * math.pi / (3.0 * area)
+        my = float(np.mean(r**3 * np.sin(phi))) * 2.0 * math.pi / (3.0 * area)
+        out[i] = st.x[v] + mx * d1 + my * d2
+    return out
+
+
+def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0,
+                       diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
+                       length_over_d0: float = 4.5, section: Any = None) -> dict[str, Any]:
+    """The wrap scene (:func:`tightknot.fem.rod_model.rod_wrap`) at the sectioned level.
+    Per tension level [N]: ``force_per_length_mid`` [N/m] (contact line load at the middle
+    per length of the nominal axis), ``kappa_d0_mid`` (its curvature),
+    ``approach_over_d0`` (of the nominal axis), ``area_ratio_mid``,
+    ``peak_pressure_over_e``, ``contact_width_fraction_mid``, ``contact_force_total``."""
+    from tightknot.knots.curvature import bergou_curvature
+    from tightknot.loading.levels import LevelLoad
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    start = time.perf_counter()
+    d0 = diameter
+    theta = 0.5 * math.radians(wrap_angle_deg)
+    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod += n_rod % 2
+    n_obs = 4 * EDGES_PER_D0
+    half = 0.5 * length_over_d0 * d0
+    s0 = 0.01 * d0  # initial overlap: the rod floats on the contact (see scenes.wrap)
+    y_obs = d0 - s0
+    mat = Material(youngs_modulus, 0.5, DENSITY)
+    b = RodBuilder(twist=False)
+    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
+    b.add_rod(_line_points(np.array([-2 * d0, y_obs, 0]), np.array([2 * d0, y_obs, 0]),
+                           n_obs), d0, mat)
+    model = b.finalize()
+    load = LevelLoad()
+    bcs = BoundaryConditions(model)
+    for k in range(n_obs + 1):
+        bcs.pin(1, k)
+    mid = wrap_constraints(bcs, n_rod, theta, load)
+    system = RodSystem(model, State.initial(model), bcs)
+    layer = _layer(model, section, (1,))
+    system.add_term(layer)
+    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
+    obs_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+
+    def measure(tension: float) -> dict[str, Any]:
+        x = system.state.x
+        g = _contact_gradient(layer, system)
+        total = float(np.linalg.norm(g[obs_v].sum(axis=0)))
+        rep = _report(layer, system)
+        xr = x[rod_v]
+        e = np.linalg.norm(np.diff(xr, axis=0), axis=1)
+        stretch = float(0.5 * (e[mid - 1] + e[mid]) / (2.0 * half / n_rod))
+        r_str = 0.5 * d0 / math.sqrt(stretch)
+        near = rod_v[mid - 3:mid + 4]
+        nominal = _far_fibre_axis(layer, system, near, y_obs, r_str)
+        seg = np.linalg.norm(np.diff(nominal, axis=0), axis=1)
+        trib = 0.5 * (seg[2] + seg[3])
+        f_mid = float(np.linalg.norm(g[rod_v[mid]])) / trib
+        kappa = float(bergou_curvature(nominal, closed=False)[3])
+        kappa_c = float(bergou_curvature(xr, closed=False)[mid])
+        cent = _centroid_axis(layer, system, near)
+        seg_c = np.linalg.norm(np.diff(cent, axis=0), axis=1)
+        f_cent = float(np.linalg.norm(g[rod_v[mid]])) / (0.5 * (seg_c[2] + seg_c[3]))
+        kappa_cent = float(bergou_curvature(cent, closed=False)[3])
+        dist = math.hypot(y_obs - nominal[3, 1], nominal[3, 2])
+        v = rod_v[mid]
+        return {
+            "tension": tension, "tension_over_e_d0sq": tension / (youngs_modulus * d0**2),
+            "approach_over_d0": (d0 - dist) / d0, "axial_stretch_mid": stretch,
+            "contact_force_total": total, "force_per_length_mid": f_mid,
+            "force_per_length_mid_over_e_d0": f_mid / (youngs_modulus * d0),
+            "area_ratio_mid": float(rep["area_ratio"][v]), "kappa_d0_mid": kappa * d0,
+            "kappa_d0_mid_centerline": kappa_c * d0,
+            "kappa_d0_mid_centroid": kappa_cent * d0,
+            "force_per_length_mid_centroid": f_cent,
+            "peak_pressure_over_e": float(rep["peak_pressure_over_E"][v]),
+            "contact_width_fraction_mid": float(rep["contact_width_fraction"][v]),
+        }
+
+    rows = _solve_levels(system, load, list(tension_levels), measure)
+    return {"steps": rows, "wall_time_s": time.perf_counter() - start,
+            "vertices": int(model.vertex_count), "contact": "sectioned",
+            "section_modes": layer.section.max_mode, "penalty": layer.penalty}
