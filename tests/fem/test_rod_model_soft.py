@@ -23,7 +23,9 @@ def test_contact_term_levels():
     assert CONTACT_LEVELS == ("compliant", "smoothed")
     compliant = contact_term(model, "compliant")
     smoothed = contact_term(model, "smoothed")
+    # the knots' own levels: compliant thins by the rod's mean stretch, smoothed by a window
     assert isinstance(compliant, ContactLayer) and compliant.radius_window == 0.0
+    assert compliant.settings.thinning == "rod"
     assert smoothed.radius_window == SMOOTHED_RADIUS_WINDOW
     with pytest.raises(ValueError, match="contact must be one of"):
         check("sectioned")

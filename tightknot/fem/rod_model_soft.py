@@ -7,11 +7,12 @@ shipped one, the overlap split evenly between the two rods (no rigid counter-bod
 scaling, unlike :mod:`tightknot.fem.rod_model`).
 
 The contact level is one parameter, ``contact``, and one small helper builds its term
-(:func:`contact_term`): a further level (the lead's ``"sectioned"``) plugs in there by one
-branch, provided its term offers what the measurements here use of a
-:class:`~tightknot.contact.layer.ContactLayer`: ``evaluate(x, rest, gradient, hessian)``
-(its gradient gives the contact forces) and :func:`tightknot.contact.report.contact_report`
-(the per-vertex L_c, A/A0 and p/E; :func:`_report` is the one call).
+(:func:`contact_term`, the knots' :func:`tightknot.knots.scenes.contact_layer`): a further
+level (``"sectioned"``) plugs in by joining :data:`CONTACT_LEVELS`, provided its term offers
+what the measurements here use of a :class:`~tightknot.contact.layer.ContactLayer`:
+``evaluate(x, rest, gradient, hessian)`` (its gradient gives the contact forces) and
+:func:`tightknot.contact.report.contact_report` (the per-vertex L_c, A/A0 and p/E;
+:func:`_report` is the one call; the sectioned level's report also takes the state).
 """
 
 from __future__ import annotations
@@ -38,18 +39,13 @@ def check_contact(contact: str) -> str:
 
 def contact_term(model: Any, contact: str = "compliant", law: Any = None) -> Any:
     """The rod model's contact term at level ``contact`` for ``model``, with the pair law
-    ``law`` (default: the shipped FEM calibration). "compliant": the radial-compliance
-    layer; "smoothed": the same with the section thinned by the stretch averaged over
-    +-1 D0 (:data:`tightknot.knots.scenes.SMOOTHED_RADIUS_WINDOW`). Two Gauss points per
-    edge pair, as in :mod:`tightknot.fem.rod_model`."""
-    from tightknot.contact.law import RadialComplianceLaw
-    from tightknot.contact.layer import ContactLayer
-    from tightknot.knots.scenes import SMOOTHED_RADIUS_WINDOW
+    ``law`` (default: the shipped FEM calibration): the knots' own definition of the level
+    (:func:`tightknot.knots.scenes.contact_layer`), so that these scenes judge the level the
+    knots are tied with. A new level joins :data:`CONTACT_LEVELS` here once its term gives
+    what :func:`_report` and the measurements read."""
+    from tightknot.knots.scenes import contact_layer
 
-    check_contact(contact)
-    law = law or RadialComplianceLaw.from_json()
-    window = SMOOTHED_RADIUS_WINDOW if contact == "smoothed" else 0.0
-    return ContactLayer(model, law, gauss_points=2, radius_window=window)
+    return contact_layer(model, check_contact(contact), law)
 
 
 def _report(term: Any, x: np.ndarray, rest: np.ndarray) -> Any:
