@@ -50,3 +50,26 @@ def soft_crossing_coarse():
     from tightknot.fem import run_scene
 
     return run_scene("soft_crossing", mesh="coarse")
+
+
+@pytest.fixture(scope="session")
+def soft_wrap_one_level():
+    """A soft rod pulled around a soft rod: one coarse level at T = 0.0069 E D0^2 (the
+    wrap's first level), no rigid run (about 100 s on 2 shared cores)."""
+    pytest.importorskip("felupe")
+    pytest.importorskip("ipctk")
+    from tightknot.fem import run_scene
+
+    return run_scene("soft_wrap", mesh="coarse", max_tension_over_e_d0sq=0.0069, steps=1,
+                     compare=False)
+
+
+@pytest.fixture(scope="session")
+def clasp_one_level():
+    """The clasp: relaxation in the clamps and one coarse level at a pull of 0.5 D0 (the
+    bends touch from about 0.4 D0 on; about 50 s on 2 shared cores)."""
+    pytest.importorskip("felupe")
+    pytest.importorskip("ipctk")
+    from tightknot.fem import run_scene
+
+    return run_scene("clasp", mesh="coarse", max_pull_over_d0=0.5, steps=1)

@@ -48,7 +48,8 @@ def test_bad_input_names_the_parameter(kwargs, name):
 
 
 def test_scenes_listed():
-    assert SCENES == ("squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing")
+    assert SCENES == ("squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing", "soft_wrap",
+                      "clasp")
 
 
 def _parser():

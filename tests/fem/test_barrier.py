@@ -140,3 +140,17 @@ def test_solver_presses_two_blocks_uniformly():
     # (1 %) lower it by a few per cent: 5 %
     for t, row in zip([0.01, 0.02], rows, strict=True):
         assert row["f"] == pytest.approx(4.0 / 3.0 * E * t / 2.0 * D0, rel=0.05)
+
+
+def test_contact_library_failure_is_a_failed_solve():
+    # ipctk raises RuntimeError (a PSD projection on crossed surfaces) or MemoryError (a
+    # CCD on a runaway step); the CLI must see a failed solve (one line, exit 1)
+    from types import SimpleNamespace
+
+    from tightknot.fem.barrier_solver import BarrierNewtonFailure, BarrierProblem
+
+    problem = SimpleNamespace(load=0.25)
+    for err in (RuntimeError("unable to project matrix"), MemoryError("std::bad_alloc")):
+        with pytest.raises(BarrierNewtonFailure, match="contact library failed at load 0.25"):
+            with BarrierProblem.failures_as_newton(problem):
+                raise err

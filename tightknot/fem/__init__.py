@@ -8,9 +8,9 @@ Toolkit) between two deformable rods in the ``soft_*`` scenes. FElupe is GPL-3.0
 Public API::
 
     run_scene(name, mesh="coarse", max_approach_over_d0=None, steps=None, **options) -> dict
-    SCENES  # names of the scenes: "squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing"
+    SCENES  # "squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing", "soft_wrap", "clasp"
     calibration.calibrate(mesh="medium"), calibration.write_law(path)
-    crosscheck.crosscheck(mesh="coarse")  # FEM versus rod model on indent and wrap
+    crosscheck.crosscheck(mesh="coarse")  # FEM vs rod model: indent, wrap, soft_wrap, clasp
     commands.register(subparsers)  # CLI subcommands "fem", "calibrate", "fem crosscheck"
 """
 
@@ -22,14 +22,15 @@ from typing import Any
 
 from ._backend import INSTALL_HINT, FelupeMissingError, require_felupe
 
-SCENES: tuple[str, ...] = ("squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing")
+SCENES: tuple[str, ...] = ("squeeze", "indent", "wrap", "soft_squeeze", "soft_crossing",
+                           "soft_wrap", "clasp")
 """Names of the implemented FEM scenes."""
 
-SOFT_SCENES: tuple[str, ...] = ("soft_squeeze", "soft_crossing")
+SOFT_SCENES: tuple[str, ...] = ("soft_squeeze", "soft_crossing", "soft_wrap", "clasp")
 """Scenes with two deformable rods in barrier contact (need ipctk as well as FElupe)."""
 
 DEFAULT_STEPS: dict[str, int] = {"squeeze": 12, "indent": 10, "wrap": 6, "soft_squeeze": 4,
-                                 "soft_crossing": 4}
+                                 "soft_crossing": 4, "soft_wrap": 6, "clasp": 6}
 """Default number of load steps per scene."""
 
 __all__ = ["SCENES", "INSTALL_HINT", "FelupeMissingError", "run_scene", "require_felupe"]
@@ -44,15 +45,18 @@ def run_scene(name: str, mesh: str = "coarse", max_approach_over_d0: float | Non
     """Run the FEM scene ``name`` and return its JSON-serialisable result.
 
     ``mesh`` is "coarse", "medium" or "fine"; ``max_approach_over_d0`` the total approach
-    of the two rigid bodies over D0 (in (0, 1); 2 w per side; default 0.3; squeeze and
-    indent only: ``wrap`` is force-controlled and takes ``max_tension_over_e_d0sq``
-    instead); ``steps`` the number of load steps (default per scene). ``options`` go to
-    the scene (squeeze: ``model`` "plane_strain" | "3d", ``ends`` "plane" | "free",
-    ``length_over_d0``; wrap: ``max_tension_over_e_d0sq``, ``wrap_angle_deg``,
-    ``length_over_d0``; soft_squeeze, soft_crossing: ``compare`` (bool, default True: also
-    run the rigid counterpart, ``squeeze`` or ``indent``), ``dhat_over_d0``; all:
-    ``convergence`` (bool, default True, False for the soft scenes: also run the three
-    meshes for the ``mesh_convergence`` table), ``diameter``, ``youngs_modulus``).
+    of the two bodies over D0 (in (0, 1); 2 w per side; default 0.3; squeeze, indent,
+    soft_squeeze and soft_crossing only: ``wrap`` and ``soft_wrap`` are force-controlled
+    and take ``max_tension_over_e_d0sq`` instead, ``clasp`` takes ``max_pull_over_d0``);
+    ``steps`` the number of load steps (default per scene). ``options`` go to the scene
+    (squeeze: ``model`` "plane_strain" | "3d", ``ends`` "plane" | "free",
+    ``length_over_d0``; wrap, soft_wrap: ``max_tension_over_e_d0sq``, ``wrap_angle_deg``,
+    ``length_over_d0``; clasp: ``max_pull_over_d0``, ``bend_radius_over_d0``,
+    ``leg_length_over_d0``; soft_squeeze, soft_crossing, soft_wrap: ``compare`` (bool,
+    default True: also run the rigid counterpart, ``squeeze``, ``indent`` or ``wrap``);
+    the two-soft-body scenes: ``dhat_over_d0``; all: ``convergence`` (bool, default True,
+    False for the two-soft-body scenes: also run the three meshes for the
+    ``mesh_convergence`` table), ``diameter``, ``youngs_modulus``).
 
     Result keys: ``scene``, ``mesh``, ``parameters``, ``steps`` (list of per-step dicts),
     ``hertz``, ``mesh_convergence``, ``wall_time_s``. Raises ValueError for bad input
@@ -63,16 +67,22 @@ def run_scene(name: str, mesh: str = "coarse", max_approach_over_d0: float | Non
         raise ValueError(f"name must be one of {SCENES}, got {name!r}")
     if steps is None:
         steps = DEFAULT_STEPS[name]
-    from .scenes import indent, soft_crossing, soft_squeeze, squeeze, wrap
+    from .scenes import clasp, indent, soft_crossing, soft_squeeze, soft_wrap, squeeze, wrap
 
     module = {"squeeze": squeeze, "indent": indent, "wrap": wrap,
-              "soft_squeeze": soft_squeeze, "soft_crossing": soft_crossing}[name]
+              "soft_squeeze": soft_squeeze, "soft_crossing": soft_crossing,
+              "soft_wrap": soft_wrap, "clasp": clasp}[name]
     loads: dict[str, Any] = {}
-    if name == "wrap":
+    if name in ("wrap", "soft_wrap"):
         if max_approach_over_d0 is not None:
             raise ValueError("max_approach_over_d0 is not a parameter of the force-controlled "
-                             "scene 'wrap': give max_tension_over_e_d0sq (tension over "
+                             f"scene {name!r}: give max_tension_over_e_d0sq (tension over "
                              "E D0^2) instead")
+    elif name == "clasp":
+        if max_approach_over_d0 is not None:
+            raise ValueError("max_approach_over_d0 is not a parameter of the scene 'clasp': "
+                             "give max_pull_over_d0 (the clamps' separation change over D0) "
+                             "instead")
     else:
         loads["max_approach_over_d0"] = (DEFAULT_APPROACH if max_approach_over_d0 is None
                                          else max_approach_over_d0)

@@ -99,20 +99,22 @@ class BarrierContact:
         full = self.field.region.mesh.points[:, : self.dim] + u
         return np.asfortranarray(self.cmesh.vertices(np.asfortranarray(full / self.length_scale)))
 
-    def _collisions(self, v: np.ndarray) -> Any:
+    def _collisions(self, v: np.ndarray, within: float | None = None) -> Any:
         c = self._ipctk.NormalCollisions()
         c.use_area_weighting = True
         # the original IPC set counts a vertex facing a vertex once per adjacent edge
         # pair: 1.75 times the area of two aligned chains of four edges (the mirrored
         # meshes of the nip scenes); the improved max approximation counts it once
         c.collision_set_type = self._ipctk.NormalCollisions.CollisionSetType.IMPROVED_MAX_APPROX
-        c.build(self.cmesh, v, self.dhat_over_scale)
+        c.build(self.cmesh, v, self.dhat_over_scale if within is None else within)
         return c
 
-    def minimum_distance_over_scale(self, displacement: np.ndarray | None = None) -> float:
-        """Smallest distance [D0] between non-adjacent surface elements (inf: none near)."""
+    def minimum_distance_over_scale(self, displacement: np.ndarray | None = None,
+                                    within: float | None = None) -> float:
+        """Smallest distance [D0] between non-adjacent surface elements closer than
+        ``within`` [D0] (default dhat); inf when none is, 0 where surfaces cross."""
         v = self._vertices(displacement)
-        c = self._collisions(v)
+        c = self._collisions(v, within)
         if c.empty():
             return float("inf")
         return float(np.sqrt(c.compute_minimum_distance(self.cmesh, v)))  # ipctk: squared

@@ -3,9 +3,10 @@
 The unknowns are the displacements u [m] of one FElupe field (all bodies in one mesh);
 displacement control moves the prescribed dofs with a load parameter t. The total energy
 
-    Pi(u) = Psi_solid(u) + U_barrier(u)
+    Pi(u) = Psi_solid(u) + U_barrier(u) - f(t) . u
 
-(no external work: all loads are prescribed displacements) is minimised at each load by
+minus the work of dead loads f(t) (``external``; zero where all loads are prescribed
+displacements) is minimised at each load by
 an own Newton loop, because the barrier needs what FElupe's ``newtonraphson`` does not
 give (with a CCD cap inside it, it stalls at first contact):
 
@@ -26,15 +27,16 @@ is set to K (v / V - 1), which :meth:`BarrierProblem.assemble` does.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from .barrier import BarrierContact
+from .linsolve import default_solver, solve_symmetric
 
 
 class BarrierNewtonFailure(RuntimeError):
@@ -55,7 +57,10 @@ class BarrierProblem:
     ``force_scale`` [N or N/m] sets the floor of the convergence test: the residual is
     compared with ``tol`` times the larger of the reaction and ``1e-4 force_scale``, far
     below FElupe's default absolute 1e-3 N, which stops soft-contact iterations before the
-    patch has formed.
+    patch has formed. ``external(t)`` (optional) returns the dead load [N] on every dof at
+    load t (force control: the load parameter is then a force level, and the applied
+    load's norm joins the reaction in the convergence scale); ``linear_solver`` names the
+    sparse solver (:mod:`tightknot.fem.linsolve`).
     """
 
     field: Any
@@ -71,6 +76,8 @@ class BarrierProblem:
     load: float = 0.0
     log: Callable[[str], None] | None = None
     intermediate_tol: float = 1e-4
+    external: Callable[[float], np.ndarray] | None = None
+    linear_solver: str = field(default_factory=default_solver)
 
     @property
     def u(self) -> np.ndarray:
@@ -104,29 +111,46 @@ class BarrierProblem:
         barrier = self.contact.energy()
         if not np.isfinite(barrier):
             return float("inf")
-        return self.solid_energy() + barrier
+        return self.solid_energy() + barrier - float(self._external(self.load) @ self.u)
+
+    def _external(self, load: float) -> np.ndarray:
+        """Dead load [N] on every dof at ``load`` (zeros without ``external``)."""
+        if self.external is None:
+            return np.zeros(self.fixed.size)
+        return np.asarray(self.external(load), dtype=float)
 
     def assemble(self, project: bool) -> tuple[np.ndarray, sp.csr_matrix]:
         """Residual dPi/du [N] and tangent [N/m] at the current displacements."""
         r, k = self._assemble_solid()
-        return r + self.contact.gradient(), (k + self.contact.hessian(project=project)).tocsr()
+        r = r + self.contact.gradient() - self._external(self.load)
+        return r, (k + self.contact.hessian(project=project)).tocsr()
 
-    def _assemble_solid(self) -> tuple[np.ndarray, sp.csr_matrix]:
+    def _set_state(self) -> None:
+        """Set the solid's condensed fields to the current displacements."""
         solid = self.solid
         state = solid.results.state
         v, vol = self._cell_volumes()
         state.u[:] = self.field[0].values
         state.J[:] = v / vol
         state.p[:] = solid.bulk * (v / vol - 1.0)  # exact Hessian (module docstring)
-        r = np.asarray(solid.assemble.vector(self.field).todense()).ravel()
-        return r, solid.assemble.matrix(self.field).tocsr()
+
+    def _assemble_solid(self) -> tuple[np.ndarray, sp.csr_matrix]:
+        self._set_state()
+        r = np.asarray(self.solid.assemble.vector(self.field).todense()).ravel()
+        return r, self.solid.assemble.matrix(self.field).tocsr()
+
+    def residual(self) -> np.ndarray:
+        """dPi/du [N or N/m] at the current displacements and load, over all dofs: at
+        the prescribed dofs, the forces that the supports exert on the bodies."""
+        self._set_state()
+        r = np.asarray(self.solid.assemble.vector(self.field).todense()).ravel()
+        return r + self.contact.gradient() - self._external(self.load)
 
     def _solve(self, k: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
         free = ~self.fixed
         k_ff = k[free][:, free].tocsc()
-        lu = splu(k_ff, diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
         du = np.zeros(self.fixed.size)
-        du[free] = lu.solve(rhs)
+        du[free] = solve_symmetric(k_ff, rhs, self.linear_solver)
         if not np.all(np.isfinite(du)):
             raise BarrierNewtonFailure("non-finite Newton step (singular tangent)")
         return du
@@ -154,7 +178,8 @@ class BarrierProblem:
         return du
 
     def _scale(self, r: np.ndarray) -> float:
-        return max(float(np.linalg.norm(r[self.fixed])), 1e-4 * self.force_scale)
+        applied = float(np.linalg.norm(self._external(self.load)))
+        return max(applied + float(np.linalg.norm(r[self.fixed])), 1e-4 * self.force_scale)
 
     def correct(self, tol: float | None = None) -> int:
         """Newton corrector at the current load to the relative residual ``tol`` (default
@@ -165,7 +190,7 @@ class BarrierProblem:
         last_res = float("inf")
         for it in range(1, self.max_iterations + 1):
             r, k_solid = self._assemble_solid()
-            r = r + self.contact.gradient()
+            r = r + self.contact.gradient() - self._external(self.load)
             res = float(np.linalg.norm(r[free]))
             scale = self._scale(r)
             if res <= tol * scale:
@@ -216,6 +241,8 @@ class BarrierProblem:
             if self.load >= target:
                 return total
             r, k = self.assemble(project=True)
+            # the predictor solves for the load at the target: its dead load enters here
+            r = r + self._external(self.load) - self._external(target)
             u0 = self.u.copy()
             du_d = np.where(self.fixed, self.prescribed(target) - u0, 0.0)
             free = ~self.fixed
@@ -246,6 +273,20 @@ class BarrierProblem:
         """Step through the increasing loads; return ``measure(load)`` at each."""
         rows = []
         for target in loads:
-            self.iterations.append(self.advance(float(target)))
+            with self.failures_as_newton():
+                self.iterations.append(self.advance(float(target)))
             rows.append(measure(float(target)))
         return rows
+
+    @contextmanager
+    def failures_as_newton(self) -> Iterator[None]:
+        """Report a failure inside the contact library (ipctk's RuntimeError, e.g. a PSD
+        projection that fails on crossed surfaces, or its MemoryError from a CCD on a
+        runaway step) as :class:`BarrierNewtonFailure`: a failed solve, not a bug."""
+        try:
+            yield
+        except BarrierNewtonFailure:
+            raise
+        except (RuntimeError, MemoryError) as err:
+            raise BarrierNewtonFailure(f"the contact library failed at load "
+                                       f"{self.load:.6g}: {err}") from err

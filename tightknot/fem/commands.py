@@ -24,6 +24,8 @@ _FEM_EXAMPLES = """examples:
   tightknot fem crosscheck --json out/crosscheck.json   # FEM (medium) versus rod model
   tightknot fem soft_squeeze --mesh medium      # two soft rods pressed together (barrier)
   tightknot fem soft_crossing --json out/x.json # two soft rods crossing at 90 degrees
+  tightknot fem soft_wrap --tension 0.25        # a soft rod pulled around a soft rod
+  tightknot fem clasp --pull 1.0 --json out/clasp.json  # two U's hooked, pulled apart
 """
 
 _CAL_EXAMPLES = """examples:
@@ -39,30 +41,42 @@ def register(subparsers: Any) -> None:
         description="Run a FEM contact scene of a nearly incompressible neo-Hookean rod "
                     "(E = 1.25 MPa, D0 = 8.5 mm) and print or save its JSON result.",
         epilog=_FEM_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    fem.add_argument("scene", help="squeeze | indent | wrap | soft_squeeze | soft_crossing, "
-                                   "or crosscheck (indent and wrap with the FEM and with "
+    fem.add_argument("scene", help="squeeze | indent | wrap | soft_squeeze | soft_crossing | "
+                                   "soft_wrap | clasp, or crosscheck (the FEM scenes with "
                                    "the rod model, compared)")
     fem.add_argument("--mesh", default=None,
                      help="coarse | medium | fine (default: coarse for a scene, medium for "
                           "crosscheck: the mesh the shipped law was calibrated on)")
     fem.add_argument("--approach", type=float, default=None,
-                     help="squeeze, indent, soft_*: total approach over D0, in (0, 1) "
-                          "(default 0.3)")
+                     help="squeeze, indent, soft_squeeze, soft_crossing: total approach "
+                          "over D0, in (0, 1) (default 0.3)")
     fem.add_argument("--tension", type=float, default=None,
-                     help="wrap only: largest end tension over E D0^2, in (0, 0.5] "
+                     help="wrap, soft_wrap: largest end tension over E D0^2, in (0, 0.5] "
                           "(default 0.25)")
     fem.add_argument("--wrap-angle", type=float, default=None,
-                     help="wrap only: angle between the two tails [deg] (default 90)")
+                     help="wrap, soft_wrap: angle between the two tails [deg] (default 90)")
+    fem.add_argument("--pull", type=float, default=None,
+                     help="clasp only: largest change of the clamps' separation over D0, "
+                          "in (0, 2] (default 1.0)")
+    fem.add_argument("--bend-radius", type=float, default=None,
+                     help="clasp only: the U's centreline bend radius over D0, in [1.25, 4] "
+                          "(default 1.5)")
+    fem.add_argument("--leg-length", type=float, default=None,
+                     help="clasp only: each leg's straight length over D0, in [1, 10] "
+                          "(default 1.5)")
     fem.add_argument("--steps", type=int, default=None, help="number of load steps")
     fem.add_argument("--model", default=None, help="squeeze only: plane_strain | 3d")
     fem.add_argument("--ends", default=None, help="squeeze 3d only: plane | free")
     fem.add_argument("--no-convergence", action="store_true",
                      help="skip the three-mesh convergence table")
     fem.add_argument("--convergence", action="store_true",
-                     help="soft_* only: add the three-mesh table (off by default: the fine "
-                          "mesh takes about 15 minutes)")
+                     help="soft_* and clasp: add the three-mesh table (off by default: the "
+                          "fine meshes take from minutes to hours)")
     fem.add_argument("--no-compare", action="store_true",
-                     help="soft_* only: skip the rigid counterpart (squeeze or indent)")
+                     help="soft_* only: skip the rigid counterpart (squeeze, indent or wrap)")
+    fem.add_argument("--no-soft", action="store_true",
+                     help="crosscheck only: leave out the two-soft-rod scenes (soft_wrap, "
+                          "clasp; on the medium mesh they take most of the time)")
     fem.add_argument("--json", default=None, metavar="FILE",
                      help="write the result to FILE (atomically) instead of stdout")
     fem.add_argument("--contact", default="compliant", choices=("compliant", "sectioned"),
@@ -114,14 +128,20 @@ def _run_fem(args: argparse.Namespace) -> int:
     from . import SOFT_SCENES
 
     if args.scene in SOFT_SCENES:
-        options: dict[str, Any] = {"convergence": args.convergence and not args.no_convergence,
-                                   "compare": not args.no_compare}
+        options: dict[str, Any] = {"convergence": args.convergence and not args.no_convergence}
+        if args.scene != "clasp":  # the clasp has no rigid counterpart
+            options["compare"] = not args.no_compare
     else:
         options = {"convergence": not args.no_convergence}
     if args.tension is not None:
         options["max_tension_over_e_d0sq"] = args.tension
     if args.wrap_angle is not None:
         options["wrap_angle_deg"] = args.wrap_angle
+    for flag, key in ((args.pull, "max_pull_over_d0"),
+                      (args.bend_radius, "bend_radius_over_d0"),
+                      (args.leg_length, "leg_length_over_d0")):
+        if flag is not None:
+            options[key] = flag
     if args.model is not None:
         options["model"] = args.model
     if args.ends is not None:
@@ -164,7 +184,8 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
                 return _fail(f"--fem-json {args.fem_json}: not a crosscheck report with "
                              f"fem_results ({err})")
         report = crosscheck(mesh=args.mesh or DEFAULT_MESH, fem_results=fem_results,
-                            contact=args.contact, section_modes=args.section_modes)
+                            contact=args.contact, section_modes=args.section_modes,
+                            soft=not args.no_soft)
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))
     if args.json is None:
@@ -181,6 +202,10 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
         line["smoothed_contact_level"] = {
             "passed": sm["passed"],
             "worst": {k: v["comparison"]["worst"] for k, v in sm["scenes"].items()}}
+    if "soft_scenes" in report:
+        line["soft_scenes"] = {
+            level: {k: v["comparison"]["worst"] for k, v in entry["scenes"].items()}
+            for level, entry in report["soft_scenes"]["levels"].items()}
     print(json.dumps(line), file=sys.stderr)
     return 0 if report["passed"] else 1
 

@@ -70,6 +70,7 @@ import math
 import time
 from typing import Any
 
+from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .material import ROD_DIAMETER
 from .rod_model import rod_indent, rod_wrap
 from .scenes._common import MESH_LEVELS, finite, relative
@@ -78,19 +79,6 @@ DEFAULT_MESH: str = "medium"
 """FEM mesh of the comparison: the mesh the shipped law was calibrated on. The coarse
 mesh differs from it by as much as the targets, so it cannot referee them
 (docs/fem_crosscheck.md)."""
-
-APPROACH_LIMIT: float = 0.25
-"""Largest approach over D0 at which the targets apply (the issue's range)."""
-
-TARGETS: dict[str, float] = {
-    "force_rel": 0.10,
-    "area_points": 0.05,
-    "curvature_rel": 0.10,
-    "width_fraction": 0.10,
-}
-"""Targets: relative force and curvature differences, area difference in points of A/A0
-(absolute), and (sectioned level) the mid section's contact width fraction L_c (absolute).
-"""
 
 CONTACT_LEVELS: tuple[str, ...] = ("compliant", "sectioned")
 """Rod-model contact levels the cross-check runs as its subject: the compliant level
@@ -351,15 +339,19 @@ def _warm_up() -> float:
 
 
 def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = None,
-               contact: str = "compliant", section_modes: int = 8) -> dict[str, Any]:
+               contact: str = "compliant", section_modes: int = 8, soft: bool = True
+               ) -> dict[str, Any]:
     """Run indent and wrap with the FEM (``mesh``) and the rod model at the contact level
     ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N) and
-    compare them.
+    compare them; at the compliant level with ``soft``, also the two-soft-rod scenes
+    soft_wrap and clasp (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, its
+    compliant level's ``passed`` part of the report's).
 
-    ``fem_results`` may hold already computed FEM results (keys "indent", "wrap", run with
-    the default load levels, as a report's ``fem_results`` keeps them) to reuse; their own
-    ``wall_time_s`` then enters the ratio. Returns the JSON-serialisable report (module
-    docstring): per-scene comparisons, ``fem_over_rod_time_ratio``, ``passed``.
+    ``fem_results`` may hold already computed FEM results (keys "indent", "wrap",
+    "soft_wrap", "clasp" and the soft scenes on the spread mesh, "soft_wrap@coarse" ...,
+    run with the default load levels, as a report's ``fem_results`` keeps them) to reuse;
+    their own ``wall_time_s`` then enters the ratio. Returns the JSON-serialisable report
+    (module docstring): per-scene comparisons, ``fem_over_rod_time_ratio``, ``passed``.
     """
     from . import run_scene
 
@@ -436,10 +428,18 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         "rod_at_least_1000x_faster": fem_time / rod_time >= 1000.0,
         "passed": (all(s["comparison"]["passed"] for s in scenes.values())
                    and fem_time / rod_time >= 1000.0),
-        "wall_time_s": time.perf_counter() - start,
         "contact": "compliant",
         "fem_results": {"indent": fem_ind, "wrap": fem_wrap},
     }
+    if soft:
+        from .crosscheck_soft import fem_runs, soft_rows
+
+        fem_results = fem_runs(mesh, fem_results)
+        report["soft_scenes"] = soft_rows(mesh, fem_results)
+        report["fem_results"].update({k: v for k, v in fem_results.items()
+                                      if k not in ("indent", "wrap")})
+        report["passed"] = report["passed"] and report["soft_scenes"]["passed"]
+    report["wall_time_s"] = time.perf_counter() - start
     return finite(report)
 
 

@@ -3,8 +3,9 @@
 Displacement control: every load parameter moves the rigid surfaces (all Dirichlet
 conditions are homogeneous symmetry or end conditions), Newton's method solves for the
 displacements, and a failed increment is cut back (halved) from the last checkpoint.
-The sparse symmetric system is factorised by SuperLU with diagonal pivoting off and the
-symmetric mode on (faster than the default on 3D hexahedral matrices).
+The sparse symmetric system is solved by :func:`tightknot.fem.linsolve.solve_symmetric`
+(MKL PARDISO where installed, else SuperLU with diagonal pivoting off and the symmetric
+mode on).
 """
 
 from __future__ import annotations
@@ -15,9 +16,9 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from .contact import PenaltyContact
+from .linsolve import solve_symmetric
 
 
 class NewtonFailure(RuntimeError):
@@ -120,9 +121,8 @@ class Problem:
             )
             scale = max(reaction, 1e-3 * self.force_scale)
             k_free = k[free][:, free].tocsc()
-            lu = splu(k_free, diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
             du = np.zeros_like(r)
-            du[free] = -lu.solve(r_free)
+            du[free] = -solve_symmetric(k_free, r_free)
             if not np.all(np.isfinite(du)):
                 raise NewtonFailure("non-finite correction")
             if self.max_backtracks > 0:

@@ -9,6 +9,7 @@ import numpy as np
 
 from .._backend import require_felupe
 from ..barrier import DHAT_OVER_D0, KAPPA_OVER_E, BarrierContact, quads_to_triangles
+from ..material import BULK_MODULUS, SHEAR_MODULUS, nearly_incompressible_solid
 from ..mesh import lumped_face_weights
 
 GAP_OVER_DHAT: float = 1.0
@@ -29,6 +30,30 @@ def stack(meshes: list[Any]) -> tuple[Any, list[np.ndarray]]:
     mesh = fem.Mesh(points=np.vstack(points), cells=np.vstack(cells),
                     cell_type=meshes[0].cell_type)
     return mesh, index
+
+
+def bodies_solid(meshes: list[Any], youngs_modulus: float
+                 ) -> tuple[Any, list[np.ndarray], Any, Any]:
+    """The bodies ``meshes`` (hexahedra) as one mesh (:func:`stack`), its 3D displacement
+    field and the nearly incompressible solid of Young's modulus ``youngs_modulus`` [Pa]
+    (mu = E/3, K/mu the material's ratio); returns (mesh, point indices per body, field,
+    solid)."""
+    fem = require_felupe()
+    body, index = stack(meshes)
+    field = fem.FieldContainer([fem.Field(fem.RegionHexahedron(body), dim=3)])
+    mu = youngs_modulus / 3.0
+    solid = nearly_incompressible_solid(field, mu=mu, bulk=BULK_MODULUS * mu / SHEAR_MODULUS)
+    return body, index, field, solid
+
+
+def turned_about_x_eq_z(mesh: Any, y_mid2: float) -> Any:
+    """``mesh`` (hexahedra) turned by 180 degrees about the line x = z, y = y_mid2 / 2:
+    (x, y, z) -> (z, y_mid2 - y, x), a proper rotation, so the cells keep their
+    orientation (a rod along e_z becomes a rod along e_x facing it)."""
+    fem = require_felupe()
+    p = mesh.points
+    return fem.Mesh(points=np.column_stack([p[:, 2], y_mid2 - p[:, 1], p[:, 0]]),
+                    cells=mesh.cells, cell_type="hexahedron")
 
 
 def barrier_faces(faces: np.ndarray) -> np.ndarray:

@@ -35,7 +35,6 @@ from ..material import (
     ROD_DIAMETER,
     SHEAR_MODULUS,
     YOUNGS_MODULUS,
-    nearly_incompressible_solid,
     poisson_ratio,
 )
 from ..measure import section_area
@@ -49,7 +48,14 @@ from ._common import (
     mesh_convergence,
     relative,
 )
-from ._pair import GAP_OVER_DHAT, contact_edge, make_barrier, nodal_contact, stack
+from ._pair import (
+    GAP_OVER_DHAT,
+    bodies_solid,
+    contact_edge,
+    make_barrier,
+    nodal_contact,
+    turned_about_x_eq_z,
+)
 from .indent import AXIAL_FINE_CELLS, REFINED_LENGTH_OVER_D0, SECTION_POINTS, axial_nodes
 
 HEADLINE_KEYS = ("force_over_e_d0sq", "semi_axis_axial_over_d0",
@@ -100,7 +106,7 @@ def run(mesh: str = "coarse", max_approach_over_d0: float = 0.3, steps: int = 4,
 
 def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0: float,
              diameter: float, youngs_modulus: float, dhat_over_d0: float) -> dict[str, Any]:
-    fem = require_felupe()
+    require_felupe()  # FElupe missing: the install hint, before any work
     start = time.perf_counter()
     radius = diameter / 2.0
     mu = youngs_modulus / 3.0
@@ -111,14 +117,9 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
     half_length = 0.5 * length_over_d0 * diameter
     rod_a = extrude(section, axial_nodes(half_length, diameter, AXIAL_FINE_CELLS[level]))
     pa = rod_a.points
-    # B = A turned by 180 degrees about the line x = z, y = y_B / 2: (x, y, z) ->
-    # (z, y_B - y, x), a proper rotation, so the hexahedra keep their orientation
-    rod_b = fem.Mesh(points=np.column_stack([pa[:, 2], y_b - pa[:, 1], pa[:, 0]]),
-                     cells=rod_a.cells, cell_type="hexahedron")
-    body, (idx_a, idx_b) = stack([rod_a, rod_b])
-    region = fem.RegionHexahedron(body)
-    field = fem.FieldContainer([fem.Field(region, dim=3)])
-    solid = nearly_incompressible_solid(field, mu=mu, bulk=bulk)
+    # B = A turned by 180 degrees about the line x = z, y = y_B / 2
+    body, (idx_a, idx_b), field, solid = bodies_solid(
+        [rod_a, turned_about_x_eq_z(rod_a, y_b)], youngs_modulus)
     pts = body.points
     n_a = rod_a.npoints
 

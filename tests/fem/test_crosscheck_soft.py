@@ -1,0 +1,71 @@
+"""The cross-check's two-soft-rod rows (tightknot.fem.crosscheck_soft): the comparison
+arithmetic, the gating, the spread, and the report built from one coarse level of each
+scene with the rod model at both contact levels."""
+
+import json
+
+import pytest
+
+pytest.importorskip("felupe")
+
+from tightknot.fem.crosscheck import APPROACH_LIMIT, TARGETS  # noqa: E402
+from tightknot.fem.crosscheck_soft import compare, soft_rows, spread_mesh  # noqa: E402
+
+
+def _fem_step(force, approach, area=0.95, kappa=0.5, pull=0.5):
+    return {"pull_over_d0": pull, "approach_over_d0": approach, "force": force,
+            "approach_nominal_over_d0": approach, "area_ratio_apex": area,
+            "kappa_d0_apex": kappa, "peak_pressure_over_e": 0.2 if force > 0.0 else 0.0}
+
+
+def _rod_step(force, area=0.94, kappa=0.55, approach=0.1):
+    return {"force": force, "area_ratio_apex": area, "kappa_d0_apex": kappa,
+            "approach_over_d0": approach,
+            "peak_pressure_over_e": 0.25, "converged": True}
+
+
+def test_compare_arithmetic_gating_and_spread():
+    fem = [_fem_step(0.0, 0.0), _fem_step(2.0, 0.1), _fem_step(3.0, APPROACH_LIMIT + 0.01)]
+    rod = [_rod_step(0.5, approach=0.0), _rod_step(2.1, approach=0.05),
+           _rod_step(3.0, approach=0.15)]
+    coarse = [_fem_step(0.0, 0.0), _fem_step(2.2, 0.1), _fem_step(3.0, 0.3)]
+    out = compare("clasp", fem, rod, coarse)
+    # the level before contact (no pressure) and the one past the approach limit are not
+    # compared; the one left is +5 % in force, -1 point in area
+    assert len(out["levels"]) == 1
+    row = out["levels"][0]
+    assert row["force_rel"] == pytest.approx(0.05)
+    assert row["area_points"] == pytest.approx(-0.01)
+    assert row["fem_spread_rel"]["force"] == pytest.approx(2.0 / 2.2 - 1.0)
+    assert row["met"] == {"force": True, "area": True, "converged": True}
+    # at the FEM's approach 0.1 the rod model's force, linear between 2.1 at 0.05 and 3.0
+    # at 0.15, is 2.55: +27.5 % at the same approach
+    assert row["force_rel_same_approach"] == pytest.approx(0.275)
+    assert "curvature" not in row["met"]  # the clasp's curvature is reported only
+    assert out["passed"]
+    rod[1] = _rod_step(2.0 * (1.0 + TARGETS["force_rel"]) * 1.01)
+    assert not compare("clasp", fem, rod, None)["passed"]
+    assert compare("clasp", fem, rod, None)["levels"][0]["fem_spread_rel"] is None
+
+
+def test_spread_mesh_is_the_next_coarser():
+    assert spread_mesh("medium") == "coarse" and spread_mesh("fine") == "medium"
+    assert spread_mesh("coarse") is None
+
+
+def test_soft_rows_from_one_coarse_level(soft_wrap_one_level, clasp_one_level):
+    rows = soft_rows("coarse", {"soft_wrap": soft_wrap_one_level,
+                                "clasp": clasp_one_level})
+    json.dumps(rows, allow_nan=False)
+    assert rows["spread_mesh"] is None
+    assert set(rows["levels"]) == {"compliant", "smoothed"}
+    for level in rows["levels"].values():
+        for name in ("soft_wrap", "clasp"):
+            cmp = level["scenes"][name]["comparison"]
+            assert len(cmp["levels"]) == 1  # one FEM level, in contact, below the limit
+            row = cmp["levels"][0]
+            assert row["rod_converged"]
+            assert row["fem_force"] > 0.0 and row["rod_force"] > 0.0
+            assert row["met"]["force"] == (abs(row["force_rel"]) <= TARGETS["force_rel"])
+            assert level["scenes"][name]["fem_over_rod_time_ratio"] > 1.0
+    assert rows["passed"] == rows["levels"]["compliant"]["passed"]

@@ -1,0 +1,74 @@
+"""The rod model's soft wrap and clasp (tightknot.fem.rod_model_soft): the contact level
+is one parameter built by one helper, statics hold, the soft pair shares the overlap."""
+
+import math
+
+import numpy as np
+import pytest
+
+from tightknot.fem.material import ROD_DIAMETER as D0
+from tightknot.fem.material import YOUNGS_MODULUS as E
+
+
+def test_contact_term_levels():
+    from tightknot.contact.layer import ContactLayer
+    from tightknot.fem.rod_model_soft import CONTACT_LEVELS, contact_term
+    from tightknot.fem.rod_model_soft import check_contact as check
+    from tightknot.knots.scenes import SMOOTHED_RADIUS_WINDOW
+    from tightknot.rods.builder import RodBuilder
+
+    b = RodBuilder(twist=False)
+    b.add_rod(np.c_[np.linspace(0, 0.1, 11), np.zeros(11), np.zeros(11)], D0)
+    model = b.finalize()
+    assert CONTACT_LEVELS == ("compliant", "smoothed")
+    compliant = contact_term(model, "compliant")
+    smoothed = contact_term(model, "smoothed")
+    # the knots' own levels: compliant thins by the rod's mean stretch, smoothed by a window
+    assert isinstance(compliant, ContactLayer) and compliant.radius_window == 0.0
+    assert compliant.settings.thinning == "rod"
+    assert smoothed.radius_window == SMOOTHED_RADIUS_WINDOW
+    with pytest.raises(ValueError, match="contact must be one of"):
+        check("sectioned")
+
+
+@pytest.fixture(scope="module")
+def soft_wrap_rod():
+    from tightknot.fem.rod_model_soft import rod_soft_wrap
+
+    tensions = [0.0069 * E * D0**2, 0.0278 * E * D0**2]
+    return tensions, rod_soft_wrap(tensions)
+
+
+def test_soft_wrap_statics_and_shared_overlap(soft_wrap_rod):
+    # frictionless statics: the contact force on the held rod is 2 T sin(theta) (1e-6:
+    # the Newton tolerance); the soft pair splits the overlap evenly, so at the same
+    # tension it overlaps more than a rod on a rigid cylinder (whose law is k 2^p)
+    from tightknot.fem.rod_model import rod_wrap
+
+    tensions, soft = soft_wrap_rod
+    rigid = rod_wrap(tensions)
+    for t, s, r in zip(tensions, soft["steps"], rigid["steps"], strict=True):
+        assert s["converged"]
+        assert s["contact_force_total"] == pytest.approx(2 * t * math.sin(math.pi / 4),
+                                                         rel=1e-6)
+        assert s["overlap_over_d0"] > r["overlap_over_d0"]
+        assert s["area_ratio_mid"] < 1.0 and s["area_ratio_mid_b"] < 1.0
+        assert s["profile_a"][0]["contact_fraction"] > 0.0
+
+
+def test_clasp_rod_model_is_symmetric_and_pulls():
+    from tightknot.fem.rod_model_soft import clasp_centrelines, rod_clasp
+    from tightknot.fem.scenes.clasp import rotate_to_b
+
+    curves, s = clasp_centrelines(1.5 * D0, 1.5 * D0, D0)
+    assert np.allclose(curves[1], rotate_to_b(curves[0]))
+    assert s[len(s) // 2] == pytest.approx(0.0)  # a vertex at the apex
+    res = rod_clasp([0.4 * D0, 0.6 * D0])
+    assert res["relaxed"]
+    a, b = res["steps"]
+    assert a["converged"] and b["converged"]
+    assert 0.0 < a["force"] < b["force"]  # touching at 0.4 D0, pulled harder at 0.6
+    # the two U's are images of each other under the half turn: same profiles (the
+    # solver's tolerance leaves 1e-6)
+    for pa, pb in zip(b["profile_a"], b["profile_b"], strict=True):
+        assert pa["area_ratio"] == pytest.approx(pb["area_ratio"], rel=1e-6)

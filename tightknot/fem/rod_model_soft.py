@@ -1,0 +1,245 @@
+"""The rod model in the FEM's two-soft-rod scenes: the soft wrap and the clasp.
+
+The same load levels and parameters as :mod:`tightknot.fem.scenes.soft_wrap` and
+:mod:`tightknot.fem.scenes.clasp`, on the rod model (DER rods, straight at rest) with its
+contact term at a chosen level. Both partners are soft here, so the pair law is the
+shipped one, the overlap split evenly between the two rods (no rigid counter-body
+scaling, unlike :mod:`tightknot.fem.rod_model`).
+
+The contact level is one parameter, ``contact``, and one small helper builds its term
+(:func:`contact_term`, the knots' :func:`tightknot.knots.scenes.contact_layer`): a further
+level (``"sectioned"``) plugs in by joining :data:`CONTACT_LEVELS`, provided its term offers
+what the measurements here use of a :class:`~tightknot.contact.layer.ContactLayer`:
+``evaluate(x, rest, gradient, hessian)`` (its gradient gives the contact forces) and
+:func:`tightknot.contact.report.contact_report` (the per-vertex L_c, A/A0 and p/E;
+:func:`_report` is the one call; the sectioned level's report also takes the state).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from .material import ROD_DIAMETER, YOUNGS_MODULUS
+from .rod_model import DENSITY, EDGES_PER_D0, _line_points, _solve_levels, wrap_constraints
+
+CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed")
+"""Contact levels of the rod model here (:func:`contact_term`)."""
+
+
+def check_contact(contact: str) -> str:
+    """``contact`` if it is one of :data:`CONTACT_LEVELS`, else ValueError naming them."""
+    if contact not in CONTACT_LEVELS:
+        raise ValueError(f"contact must be one of {CONTACT_LEVELS}, got {contact!r}")
+    return contact
+
+
+def contact_term(model: Any, contact: str = "compliant", law: Any = None) -> Any:
+    """The rod model's contact term at level ``contact`` for ``model``, with the pair law
+    ``law`` (default: the shipped FEM calibration): the knots' own definition of the level
+    (:func:`tightknot.knots.scenes.contact_layer`), so that these scenes judge the level the
+    knots are tied with. A new level joins :data:`CONTACT_LEVELS` here once its term gives
+    what :func:`_report` and the measurements read."""
+    from tightknot.knots.scenes import contact_layer
+
+    return contact_layer(model, check_contact(contact), law)
+
+
+def _report(term: Any, x: np.ndarray, rest: np.ndarray) -> Any:
+    """Per-vertex contact outputs of the term (L_c, A/A0, p/E, overlap)."""
+    from tightknot.contact.report import contact_report
+
+    return contact_report(term, x, rest)
+
+
+def _profile(report: Any, vertices: np.ndarray, s_rest: np.ndarray,
+             diameter: float) -> list[dict[str, float]]:
+    """Per vertex of one rod: rest arc length, A/A0, L_c and p_max/E."""
+    return [{"s_over_d0": float(s) / diameter,
+             "area_ratio": float(report.area_ratio[v]),
+             "contact_fraction": float(report.contact_width_fraction[v]),
+             "peak_pressure_over_e": float(report.peak_pressure_over_E[v])}
+            for v, s in zip(vertices, s_rest, strict=True)]
+
+
+def _builder_rod(points: np.ndarray, diameter: float, youngs_modulus: float) -> tuple:
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+
+    b = RodBuilder(twist=False)
+    b.add_rod(points[0], diameter, Material(youngs_modulus, 0.5, DENSITY))
+    b.add_rod(points[1], diameter, Material(youngs_modulus, 0.5, DENSITY))
+    return b.finalize()
+
+
+def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
+                  diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
+                  length_over_d0: float = 4.5, law: Any = None,
+                  contact: str = "compliant") -> dict[str, Any]:
+    """The soft wrap with the rod model: rod A (axis e_z at rest) pulled by dead end forces
+    T (0, sin(theta), +-cos(theta)) [N] (``tension_levels``) around rod B along e_x, held
+    straight (the FEM scene's stack keeps B's axis straight), with the soft pair law.
+
+    Returns per level the keys of :func:`tightknot.fem.rod_model.rod_wrap` (the mid line
+    load per length of the centreline, curvature, approach, overlap, A/A0, peak pressure)
+    and ``area_ratio_mid_b``, ``profile_a``, ``profile_b``; and the wall time.
+    """
+    from tightknot.knots.curvature import bergou_curvature
+    from tightknot.loading.levels import LevelLoad
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    start = time.perf_counter()
+    check_contact(contact)
+    d0 = diameter
+    theta = 0.5 * math.radians(wrap_angle_deg)
+    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod += n_rod % 2
+    n_obs = 4 * EDGES_PER_D0
+    half = 0.5 * length_over_d0 * d0
+    s0 = 0.01 * d0  # initial overlap: A floats on the contact (see scenes.wrap)
+    y_obs = d0 - s0
+    model = _builder_rod((_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod),
+                          _line_points(np.array([-2 * d0, y_obs, 0]),
+                                       np.array([2 * d0, y_obs, 0]), n_obs)),
+                         d0, youngs_modulus)
+    load = LevelLoad()
+    bcs = BoundaryConditions(model)
+    for k in range(n_obs + 1):
+        bcs.pin(1, k)
+    mid = wrap_constraints(bcs, n_rod, theta, load)
+    system = RodSystem(model, State.initial(model), bcs)
+    term = contact_term(model, contact, law)
+    system.add_term(term)
+    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
+    obs_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+    s_a = np.linspace(-half, half, n_rod + 1)
+    s_b = np.linspace(-2 * d0, 2 * d0, n_obs + 1)
+
+    def measure(tension: float) -> dict[str, Any]:
+        x = system.state.x
+        rest = model.edge_rest_length
+        _, g, _ = term.evaluate(x, rest, True, False)
+        xr = x[rod_v]
+        e = np.linalg.norm(np.diff(xr, axis=0), axis=1)
+        voronoi = 0.5 * (e[mid - 1] + e[mid])
+        f_mid = float(np.linalg.norm(g[rod_v[mid]]) / voronoi)
+        xm = xr[mid]
+        dist = math.hypot(y_obs - xm[1], xm[2])
+        rep = _report(term, x, rest)
+        prof_a = _profile(rep, rod_v, s_a, d0)
+        prof_b = _profile(rep, obs_v, s_b, d0)
+        return {
+            "tension": tension,
+            "tension_over_e_d0sq": tension / (youngs_modulus * d0**2),
+            "approach_over_d0": (d0 - dist) / d0,
+            "overlap_over_d0": float(rep.overlap[rod_v[mid]]) / d0,
+            "axial_stretch_mid": float(voronoi / (2.0 * half / n_rod)),
+            "contact_force_total": float(np.linalg.norm(g[obs_v].sum(axis=0))),
+            "force_per_length_mid": f_mid,
+            "force_per_length_mid_over_e_d0": f_mid / (youngs_modulus * d0),
+            "kappa_d0_mid": float(bergou_curvature(xr, closed=False)[mid]) * d0,
+            "area_ratio_mid": prof_a[mid]["area_ratio"],
+            "area_ratio_mid_b": prof_b[n_obs // 2]["area_ratio"],
+            "peak_pressure_over_e": prof_a[mid]["peak_pressure_over_e"],
+            "contact_fraction_max": max(r["contact_fraction"] for r in prof_a),
+            "profile_a": prof_a[mid:],
+            "profile_b": prof_b[n_obs // 2:],
+        }
+
+    rows = _solve_levels(system, load, list(tension_levels), measure)
+    return {"steps": rows, "wall_time_s": time.perf_counter() - start,
+            "vertices": int(model.vertex_count), "contact": contact}
+
+
+def clasp_centrelines(bend_radius: float, leg_length: float, diameter: float,
+                      edges_per_d0: int = EDGES_PER_D0) -> tuple[np.ndarray, np.ndarray]:
+    """Both U's of the clasp scene (:mod:`tightknot.fem.scenes.clasp`) as vertex arrays
+    [m], clamp to clamp through the apex (an even number of edges, a vertex at the apex),
+    and the rest arc length of each vertex from the apex [m]."""
+    from .scenes.clasp import rotate_to_b, u_centreline
+
+    x_apex = 0.5 * diameter  # touching: the FEM's gap g0 is below the rod's resolution
+    length = 0.5 * math.pi * bend_radius + leg_length
+    n_half = int(round(length / diameter * edges_per_d0))
+    s = np.linspace(-length, length, 2 * n_half + 1)
+    c, _ = u_centreline(np.abs(s), bend_radius, x_apex - bend_radius)
+    c[s < 0.0, 1] *= -1.0
+    return np.stack([c, rotate_to_b(c)]), s
+
+
+def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
+              leg_length_over_d0: float = 1.5, diameter: float = ROD_DIAMETER,
+              youngs_modulus: float = YOUNGS_MODULUS, law: Any = None,
+              contact: str = "compliant") -> dict[str, Any]:
+    """The clasp with the rod model: two U's (straight at rest, started on the FEM
+    scene's U, :func:`clasp_centrelines`), each end clamped (its two end vertices held),
+    relaxed, then the clamps moved apart along x by ``pull_levels`` [m] (half each).
+
+    Returns per level: ``force`` [N] (the x contact force on A: the pull, by statics),
+    ``approach_over_d0`` (D0 minus the apex vertices' distance), ``kappa_d0_apex``,
+    ``area_ratio_apex``, ``peak_pressure_over_e``, ``contact_fraction_max``,
+    ``profile_a``/``profile_b`` (from the apex to a clamp); and the wall time.
+    """
+    from tightknot.knots.curvature import bergou_curvature
+    from tightknot.loading.levels import LevelLoad, LevelOptions, LevelPath
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.state import State
+    from tightknot.solvers.program import Program
+    from tightknot.solvers.system import RodSystem
+
+    start = time.perf_counter()
+    check_contact(contact)
+    d0 = diameter
+    curves, s = clasp_centrelines(bend_radius_over_d0 * d0, leg_length_over_d0 * d0, d0)
+    model = _builder_rod(curves, d0, youngs_modulus)
+    n = len(s) - 1
+    apex = n // 2
+    load = LevelLoad()
+    bcs = BoundaryConditions(model)
+    for rod, sign in ((0, -1.0), (1, 1.0)):
+        for k in (0, 1, n - 1, n):
+            bcs.pin(rod, k, translation=lambda t, sg=sign: np.array([0.5 * sg * load(t),
+                                                                      0.0, 0.0]))
+    system = RodSystem(model, State.initial(model), bcs)
+    term = contact_term(model, contact, law)
+    system.add_term(term)
+    va = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n + 1)
+    vb = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n + 1)
+    # the rods settle in their clamps first (straight at rest, started bent)
+    path = LevelPath(system, load, LevelOptions(steps="one", proximal_dt=1e-3), level=0.0)
+    relaxed = not Program(path.solve(0.0), "relax").run()
+
+    def measure(pull: float) -> dict[str, Any]:
+        x = system.state.x
+        rest = model.edge_rest_length
+        _, g, _ = term.evaluate(x, rest, True, False)
+        force = -float(g[va, 0].sum())
+        rep = _report(term, x, rest)
+        prof_a = _profile(rep, va[apex:], s[apex:], d0)
+        prof_b = _profile(rep, vb[apex:], s[apex:], d0)
+        xa = x[va]
+        e = np.linalg.norm(np.diff(xa, axis=0), axis=1)
+        stretch = float(0.5 * (e[apex - 1] + e[apex]) / (s[1] - s[0]))
+        return {
+            "pull_over_d0": pull / d0,
+            "force": force,
+            "force_over_e_d0sq": force / (youngs_modulus * d0**2),
+            "approach_over_d0": (d0 - float(np.linalg.norm(xa[apex] - x[vb[apex]]))) / d0,
+            "axial_stretch_apex": stretch,
+            "kappa_d0_apex": float(bergou_curvature(xa, closed=False)[apex]) * d0,
+            "area_ratio_apex": prof_a[0]["area_ratio"],
+            "area_ratio_min": min(r["area_ratio"] for r in prof_a),
+            "peak_pressure_over_e": max(r["peak_pressure_over_e"] for r in prof_a),
+            "contact_fraction_max": max(r["contact_fraction"] for r in prof_a),
+            "profile_a": prof_a,
+            "profile_b": prof_b,
+        }
+
+    rows = _solve_levels(system, load, list(pull_levels), measure) if relaxed else []
+    return {"steps": rows, "relaxed": relaxed, "wall_time_s": time.perf_counter() - start,
+            "vertices": int(model.vertex_count), "contact": contact}
