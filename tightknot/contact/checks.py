@@ -137,9 +137,7 @@ def deepest_approaches(layer: object, x: np.ndarray, rest: np.ndarray
     ``angle_line_deg``: line contact) and among crossing pairs (point contact, or the
     blend toward it); 0 where none touches. The overlaps are the pair kernel's, of the
     nominal stretched sections (at the sectioned level: how far the sections flatten)."""
-    from tightknot.contact.layer import ContactLayer
-
-    ContactLayer.evaluate(layer, x, rest, False, False)
+    layer.energy.evaluate(x, rest, False, False)
     pairs, overlap = layer.last_pairs, layer.last_overlap
     touch = overlap > 0.0
     if not touch.any():
