@@ -12,6 +12,7 @@ from tightknot.fem.material import YOUNGS_MODULUS as E
 
 def test_contact_term_levels():
     from tightknot.contact.layer import ContactLayer
+    from tightknot.contact.sectioned import SectionedLayer
     from tightknot.fem.rod_model_soft import CONTACT_LEVELS, contact_term
     from tightknot.fem.rod_model_soft import check_contact as check
     from tightknot.knots.scenes import SMOOTHED_RADIUS_WINDOW
@@ -20,15 +21,16 @@ def test_contact_term_levels():
     b = RodBuilder(twist=False)
     b.add_rod(np.c_[np.linspace(0, 0.1, 11), np.zeros(11), np.zeros(11)], D0)
     model = b.finalize()
-    assert CONTACT_LEVELS == ("compliant", "smoothed")
+    assert CONTACT_LEVELS == ("compliant", "smoothed", "sectioned")
     compliant = contact_term(model, "compliant")
     smoothed = contact_term(model, "smoothed")
     # the knots' own levels: compliant thins by the rod's mean stretch, smoothed by a window
     assert isinstance(compliant, ContactLayer) and compliant.radius_window == 0.0
     assert compliant.settings.thinning == "rod"
     assert smoothed.radius_window == SMOOTHED_RADIUS_WINDOW
+    assert isinstance(contact_term(model, "sectioned"), SectionedLayer)
     with pytest.raises(ValueError, match="contact must be one of"):
-        check("sectioned")
+        check("soft")
 
 
 @pytest.fixture(scope="module")

@@ -8,11 +8,11 @@ scaling, unlike :mod:`tightknot.fem.rod_model`).
 
 The contact level is one parameter, ``contact``, and one small helper builds its term
 (:func:`contact_term`, the knots' :func:`tightknot.knots.scenes.contact_layer`): a further
-level (``"sectioned"``) plugs in by joining :data:`CONTACT_LEVELS`, provided its term offers
-what the measurements here use of a :class:`~tightknot.contact.layer.ContactLayer`:
-``evaluate(x, rest, gradient, hessian)`` (its gradient gives the contact forces) and
-:func:`tightknot.contact.report.contact_report` (the per-vertex L_c, A/A0 and p/E;
-:func:`_report` is the one call; the sectioned level's report also takes the state).
+level plugs in by joining :data:`CONTACT_LEVELS` (the sectioned level has), provided its term
+offers what the measurements here use:
+its contact forces (:meth:`tightknot.solvers.system.RodSystem.term_gradient`) and
+:func:`tightknot.contact.report.contact_report` at the system's state (the per-vertex L_c,
+A/A0 and p/E; :func:`_report` is the one call).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 from .material import ROD_DIAMETER, YOUNGS_MODULUS
 from .rod_model import DENSITY, EDGES_PER_D0, _line_points, _solve_levels, wrap_constraints
 
-CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed")
+CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed", "sectioned")
 """Contact levels of the rod model here (:func:`contact_term`)."""
 
 
@@ -48,11 +48,12 @@ def contact_term(model: Any, contact: str = "compliant", law: Any = None) -> Any
     return contact_layer(model, check_contact(contact), law)
 
 
-def _report(term: Any, x: np.ndarray, rest: np.ndarray) -> Any:
-    """Per-vertex contact outputs of the term (L_c, A/A0, p/E, overlap)."""
+def _report(term: Any, system: Any) -> Any:
+    """Per-vertex contact outputs of the term (L_c, A/A0, p/E, overlap) at the system's
+    state (the sectioned level reads its sections there)."""
     from tightknot.contact.report import contact_report
 
-    return contact_report(term, x, rest)
+    return contact_report(term, system.state.x, system.rest, system.state)
 
 
 def _profile(report: Any, vertices: np.ndarray, s_rest: np.ndarray,
@@ -122,15 +123,14 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
 
     def measure(tension: float) -> dict[str, Any]:
         x = system.state.x
-        rest = model.edge_rest_length
-        _, g, _ = term.evaluate(x, rest, True, False)
+        g = system.term_gradient(term)
         xr = x[rod_v]
         e = np.linalg.norm(np.diff(xr, axis=0), axis=1)
         voronoi = 0.5 * (e[mid - 1] + e[mid])
         f_mid = float(np.linalg.norm(g[rod_v[mid]]) / voronoi)
         xm = xr[mid]
         dist = math.hypot(y_obs - xm[1], xm[2])
-        rep = _report(term, x, rest)
+        rep = _report(term, system)
         prof_a = _profile(rep, rod_v, s_a, d0)
         prof_b = _profile(rep, obs_v, s_b, d0)
         return {
@@ -216,10 +216,9 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
 
     def measure(pull: float) -> dict[str, Any]:
         x = system.state.x
-        rest = model.edge_rest_length
-        _, g, _ = term.evaluate(x, rest, True, False)
+        g = system.term_gradient(term)
         force = -float(g[va, 0].sum())
-        rep = _report(term, x, rest)
+        rep = _report(term, system)
         prof_a = _profile(rep, va[apex:], s[apex:], d0)
         prof_b = _profile(rep, vb[apex:], s[apex:], d0)
         xa = x[va]
