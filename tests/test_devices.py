@@ -63,6 +63,33 @@ def test_one_evaluation_agrees_with_the_cpu() -> None:
     assert gpu.max_step(u, du) == pytest.approx(cpu.max_step(u, du), rel=1e-12)
 
 
+def test_the_sectioned_level_evaluates_as_on_the_cpu() -> None:
+    # the sectioned level's kernels (node-pair blocks added with atomics) on both devices,
+    # sections deformed at random on the squeezed trefoil
+    from tightknot.contact.sectioned import SectionSettings
+    from tightknot.knots.scenes import closed_trefoil, gauge
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    out = []
+    for dev in ("cpu", CUDA):
+        scene = closed_trefoil(l0_over_d0=16.37, nodes=100, device=dev,
+                               contact=SectionSettings())
+        x = scene.model.vertex_initial_position * 0.93
+        system = RodSystem(scene.model, State.initial(scene.model, positions=x), gauge(scene))
+        system.add_term(scene.contact)
+        system.set_load(0.0)
+        rng = np.random.default_rng(0)
+        system.state.extra = 1e-5 * rng.standard_normal(system.state.extra.size)
+        out.append((*system.evaluate(system.free_vector(), True, True),
+                    system.last_split.extra["contact"]))
+    (e0, g0, h0, c0), (e1, g1, h1, _) = out
+    assert c0 > 0.0
+    assert e1 == pytest.approx(e0, rel=1e-12)
+    assert np.abs(g1 - g0).max() <= 1e-10 * np.abs(g0).max()
+    assert abs(h1 - h0).max() <= 1e-10 * abs(h0).max()
+
+
 def _invariants(x: np.ndarray, scene) -> tuple[float, float, float]:
     from tightknot.knots.measure import analyze_centerline
 
