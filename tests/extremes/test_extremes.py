@@ -330,3 +330,16 @@ def test_the_force_range_keeps_the_trefoil_at_every_level() -> None:
     for r in rows:
         assert r["converged"], r["failure"]
         assert r["knot_type"] == "3_1" and r["min_gap_over_D0"] >= 0.3
+
+
+def test_a_long_rods_levels_are_refined_to_its_own_resolution() -> None:
+    # A rod of more vertices than the path's follows its levels on the path's count and
+    # refines each one to its own (the 1 m rod's 1682 from 600 in the benchmark; here 130
+    # from 90 on the 185 mm rod): every reported level is the rod's own equilibrium.
+    from tightknot.benchmarks.force_range import rod_rows
+
+    rows = rod_rows(0.185, levels=2, nodes=130, path_nodes=90)
+    assert [r["path_vertices"] for r in rows] == [90, 90]
+    for r in rows:
+        assert r["vertices"] == 130 and r["converged"], r["failure"]
+        assert r["knot_type"] == "3_1" and r["min_gap_over_D0"] >= 0.3
