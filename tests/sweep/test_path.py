@@ -89,10 +89,10 @@ def test_the_tightest_level_of_a_path_is_the_tightest_level_alone() -> None:
 def test_a_long_rod_ties_coarse_first_by_the_rule_of_tie() -> None:
     from tightknot.loading.options import REFINE_FROM, default_coarse_nodes
 
-    # The sweep's path and `tightknot tie` take one rule: a rod of more than twice
+    # The sweep's path and `tightknot tie` take one rule: a rod of more than 1.5 times
     # REFINE_FROM vertices ties on REFINE_FROM first.
-    assert default_coarse_nodes(2 * REFINE_FROM) is None
-    assert default_coarse_nodes(2 * REFINE_FROM + 1) == REFINE_FROM
+    assert default_coarse_nodes(3 * REFINE_FROM // 2) is None
+    assert default_coarse_nodes(3 * REFINE_FROM // 2 + 1) == REFINE_FROM
 
 
 def test_a_path_tied_by_mesh_continuation_reaches_the_level_tied_fine() -> None:

@@ -5,7 +5,11 @@ pulled level by level along one continuation path (:func:`tightknot.sweep.path.
 tightness_path`), at geometrically spaced dead forces from the loosest to 0.3 EA. The
 loosest is the force whose loop radius sqrt(B / 2T) (the planar elastica's, physics.md sec.
 5) is 1/12 of the rest length: about 10 D0 on the 1 m rod, where the knot still fits
-between the grips with tails to spare. Every level reports whether it was reached, its
+between the grips with tails to spare. A rod of more than :data:`PATH_NODES` vertices (the
+1 m rod: 1682 by default) follows its levels on that many and refines each level reached to
+its own count by mesh continuation (one static solve per doubling, the knot type checked):
+every reported level is an equilibrium of the rod at its own resolution, reached along a
+coarser path. Every level reports whether it was reached, its
 knot type, Lambda_OC, the smallest gap between pieces of rod, the deepest squeeze against
 the law's calibrated range (the deepest contact against the range of the law with its
 core, the deepest crossing against the point law's fit; a level beyond either carries the
@@ -30,6 +34,11 @@ DEFAULT_LEVELS = 12
 TOP_OVER_EA = 0.3
 #: The loosest pull's loop radius over the rest length.
 LOOP_OVER_LENGTH = 1.0 / 12.0
+#: Vertices of the rod along which a longer rod's levels are followed; each level reached
+#: is then refined to the rod's own count. A loose knot on a long rod swings through large
+#: floppy shapes from level to level: at 1682 vertices (the 1 m rod's default) the second
+#: level alone took 7549 Newton iterations and failed, at 600 all twelve took 12 000.
+PATH_NODES = 600
 
 
 def forces(scene: Any, levels: int = DEFAULT_LEVELS) -> list[float]:
@@ -43,25 +52,75 @@ def forces(scene: Any, levels: int = DEFAULT_LEVELS) -> list[float]:
     return [float(f) for f in np.geomspace(loosest, TOP_OVER_EA * ea, levels)]
 
 
+def refined_level(scene: Any, x: np.ndarray, force: float, path_nodes: int,
+                  residual_tol: float) -> Any:
+    """The equilibrium of ``scene`` (its own vertex count) under the dead ``force`` [N],
+    from the centerline ``x`` [m] of the same knot on ``path_nodes`` vertices: carried and
+    solved again at each count of the mesh continuation (:mod:`tightknot.loading.refine`),
+    the knot type checked. Returns the final :class:`~tightknot.loading.tie.TieResult`."""
+    from tightknot.loading.refine import carry, refinements, resolve
+    from tightknot.loading.tie import TieResult
+    from tightknot.solvers.program import Program
+
+    res = TieResult(True, "", {}, 0, 0.0, [], force, None)
+    own = scene.model.vertex_count
+    for n in refinements(path_nodes, own):
+        fine = scene if n == own else scene.rebuild(n)
+        res = Program(resolve(fine, carry(x, False, n), res, force, residual_tol),
+                      "refine").run()
+        if not res.converged:
+            break
+        x = res.system.state.x
+    return res
+
+
 def rod_rows(length: float, levels: int = DEFAULT_LEVELS, nodes: int | None = None,
-             contact: str = "compliant", device: str = "cpu") -> list[dict[str, Any]]:
+             contact: str = "compliant", device: str = "cpu",
+             path_nodes: int = PATH_NODES) -> list[dict[str, Any]]:
     """The levels of one rod of rest length ``length`` [m] (default vertex count from its
-    length)."""
+    length). A rod of more than ``path_nodes`` vertices follows its levels on
+    ``path_nodes`` vertices and refines each one reached to its own count."""
     from tightknot.knots.scenes import open_trefoil
-    from tightknot.sweep.path import tightness_path
+    from tightknot.loading.options import LoadPath
+    from tightknot.sweep.path import measure, tightness_path
 
     scene = open_trefoil(rest_length=length, nodes=nodes, contact=contact, device=device)
+    own = scene.model.vertex_count
+    along = scene if own <= path_nodes else scene.rebuild(path_nodes)
     t0 = time.perf_counter()
-    path = tightness_path(scene, pull_force=forces(scene, levels))
+    refined: dict[int, tuple[Any, dict | None, float]] = {}
+
+    def refine(lv: Any) -> None:
+        # each level as soon as the path reaches it (the path's own state moves on)
+        if along is scene or not lv.reached:
+            return
+        t1 = time.perf_counter()
+        x = np.asarray(lv.summary["centerline_m"])
+        res = refined_level(scene, x, lv.target, path_nodes, LoadPath.residual_tol)
+        summary = measure(scene, res) if res.converged else None
+        refined[id(lv)] = (res, summary, time.perf_counter() - t1)
+
+    path = tightness_path(along, pull_force=forces(scene, levels), on_level=refine)
     rows = []
     for lv in path.levels:
         s = lv.summary or {}
+        reached, failure = bool(lv.reached), lv.failure
+        iterations, wall = lv.newton_iterations, lv.wall_time_s
+        lam = lv.lambda_oc
+        if id(lv) in refined:
+            res, s, dt = refined[id(lv)]
+            s = s or {}
+            reached, failure = res.converged, res.failure
+            iterations += res.newton_iterations
+            wall += dt
+            lam = s.get("lambda_oc")
         rows.append({
-            "rest_length_m": length, "vertices": scene.model.vertex_count,
+            "rest_length_m": length, "vertices": own, "path_vertices":
+                along.model.vertex_count,
             "force_N": lv.target, "force_over_EA": lv.target / (
                 scene.model.rods[0].material.youngs_modulus * math.pi * scene.diameter**2 / 4),
-            "converged": bool(lv.reached), "knot_type": s.get("knot_type"),
-            "lambda_oc": lv.lambda_oc, "min_gap_over_D0": s.get("min_gap_over_D0"),
+            "converged": reached, "knot_type": s.get("knot_type"),
+            "lambda_oc": lam, "min_gap_over_D0": s.get("min_gap_over_D0"),
             "max_approach_w_over_D0": s.get("max_approach_w_over_D0"),
             "calibrated_w_over_D0": s.get("calibrated_w_over_D0"),
             "max_crossing_w_over_D0": s.get("max_crossing_w_over_D0"),
@@ -69,10 +128,9 @@ def rod_rows(length: float, levels: int = DEFAULT_LEVELS, nodes: int | None = No
             "outside_calibrated_range": s.get("outside_calibrated_range"),
             "warnings": s.get("warnings", []),
             "min_area_ratio": s.get("min_area_ratio"),
-            "newton_iterations": lv.newton_iterations, "wall_time_s": lv.wall_time_s,
-            "failure": lv.failure})
+            "newton_iterations": iterations, "wall_time_s": wall, "failure": failure})
     if not path.levels:
-        rows.append({"rest_length_m": length, "vertices": scene.model.vertex_count,
+        rows.append({"rest_length_m": length, "vertices": own,
                      "force_N": None, "converged": False, "knot_type": None,
                      "lambda_oc": None, "min_gap_over_D0": None,
                      "wall_time_s": time.perf_counter() - t0, "failure": path.failure})
