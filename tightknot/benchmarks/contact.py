@@ -1,6 +1,6 @@
 """What self-contact adds to a Newton iteration (the contact issue's speed target).
 
-Scene: the study's tight open trefoil (125 mm, 300 vertices, pulled by 5.67 N to Lambda_OC
+Scene: the study's tight open trefoil (125 mm, 300 vertices, pulled by 7.43 N to Lambda_OC
 about 10.1). From that equilibrium the pull is raised by 10 % (``REPULL``), and the first
 Newton iteration of that load step (a real step: the residual of the new load, the
 equilibrium's contacts) is timed piece by piece, each the minimum over repeats (the machines
@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 #: The tight open knot of the study: rest length [m], pulling force [N], vertices.
-SCENE = {"rest_length_m": 0.125, "pull_force_N": 5.67, "vertices": 300}
+SCENE = {"rest_length_m": 0.125, "pull_force_N": 7.43, "vertices": 300}
 
 #: The timed load step raises the pull from F to REPULL F.
 REPULL = 1.10

@@ -65,9 +65,10 @@ def _solve_levels(system: Any, load: LevelLoad, levels: list[float],
 
 
 def _section_stretch(layer: Any, x: np.ndarray, model: Any, mid: int, own: float) -> float:
-    """The stretch that thins the rod's mid section: ``own`` (the mid edges' mean) or, with a
-    radius window, the layer's window mean over the two mid edges."""
-    if layer.radius_window == 0.0:
+    """The stretch that thins the rod's mid section: ``own`` (the mid edges' mean) for a layer
+    thinning each edge by its own stretch, else the layer's (a window mean, or the rod's mean
+    stretch) over the two mid edges."""
+    if layer.radius_window == 0.0 and layer.thinning == "edge":
         return own
     lam = layer.section_stretch(x, model.edge_rest_length)
     e0 = model.rods[0].edge_start
@@ -77,13 +78,14 @@ def _section_stretch(layer: Any, x: np.ndarray, model: Any, mid: int, own: float
 def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
                youngs_modulus: float = YOUNGS_MODULUS, length_over_d0: float = 3.0,
                law: Any = None, poisson_ratio: float = 0.5,
-               radius_window: float = 0.0) -> dict[str, Any]:
+               radius_window: float = 0.0, thinning: str = "rod") -> dict[str, Any]:
     """The indent scene with the rod model: a straight rod (axis e_z) between two pinned
     rods along e_x that move toward its axis by w [m] each (``w_levels``).
 
     ``poisson_ratio`` of the rod (a diagnostic at 0: the contact radius r0 lambda^(-nu)
     then does not thin with stretch; the straight rod's bending plays no role).
-    ``radius_window``: the contact layer's (:class:`tightknot.contact.layer.ContactLayer`).
+    ``radius_window``, ``thinning``: the contact layer's (:class:`tightknot.contact.layer.
+    ContactLayer`; the default "rod" is the knots' default level, a window takes "edge").
     Returns per level: ``force`` [N] from the upper indenter, ``overlap_over_d0``,
     ``axial_force_mid_over_e_d0sq`` (the contact forces' axial resultant on one half),
     ``area_ratio_mid``, ``peak_pressure_over_e``, and the wall time.
@@ -127,7 +129,8 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
     bcs.fix_components(0, 0, (1,))
     bcs.fix_components(0, -1, (1,))
     system = RodSystem(model, State.initial(model), bcs)
-    layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window)
+    layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window,
+                         thinning="edge" if radius_window > 0.0 else thinning)
     system.add_term(layer)
     rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
     up_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
@@ -189,15 +192,15 @@ def wrap_constraints(bcs: Any, n_rod: int, theta: float, load: LevelLoad) -> int
 def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
              diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
              length_over_d0: float = 4.5, law: Any = None,
-             radius_window: float = 0.0) -> dict[str, Any]:
+             radius_window: float = 0.0, thinning: str = "rod") -> dict[str, Any]:
     """The wrap scene with the rod model: a rod (axis e_z at rest) pulled by dead end
     forces T (0, sin(theta), +-cos(theta)) around a pinned rod along e_x above it.
 
     Returns per tension level [N]: ``force_per_length_mid`` [N/m] (contact line load at
     the middle vertex over its deformed Voronoi length), ``contact_force_total`` [N],
     ``approach_over_d0``, ``overlap_over_d0``, ``area_ratio_mid``, ``kappa_d0_mid``
-    (Bergou curvature), ``peak_pressure_over_e`` and the wall time. ``radius_window``: the
-    contact layer's (:class:`tightknot.contact.layer.ContactLayer`).
+    (Bergou curvature), ``peak_pressure_over_e`` and the wall time. ``radius_window``,
+    ``thinning``: the contact layer's (as :func:`rod_indent`).
     """
     from tightknot.contact.law import RadialComplianceLaw
     from tightknot.contact.layer import ContactLayer
@@ -232,7 +235,8 @@ def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
         bcs.pin(1, k)
     mid = wrap_constraints(bcs, n_rod, theta, load)
     system = RodSystem(model, State.initial(model), bcs)
-    layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window)
+    layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window,
+                         thinning="edge" if radius_window > 0.0 else thinning)
     system.add_term(layer)
     rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
     obs_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
