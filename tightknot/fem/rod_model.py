@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -40,6 +40,112 @@ def rigid_counterbody_law(law: Any) -> Any:
 
 def _line_points(start: np.ndarray, end: np.ndarray, edges: int) -> np.ndarray:
     return np.linspace(start, end, edges + 1)
+
+
+@dataclass
+class RodScene:
+    """A rod-model scene before its contact layer: the system, its level load, and where
+    its rods are (the compared rod 0 of ``n_rod`` edges, the counter-bodies of ``n_obs``)."""
+
+    system: Any
+    load: Any
+    n_rod: int
+    n_obs: int
+    mid: int
+    half: float
+    rod_v: np.ndarray
+    obs_v: np.ndarray
+
+    @property
+    def model(self) -> Any:
+        return self.system.model
+
+
+def _vertices(model: Any, rod: int, edges: int) -> np.ndarray:
+    start = model.rods[rod].vertex_start
+    return np.arange(start, start + edges + 1)
+
+
+def indent_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
+                 poisson_ratio: float = 0.5) -> RodScene:
+    """The indent scene's rods and constraints: a straight rod (axis e_z, Poisson ratio
+    ``poisson_ratio``) between two pinned rods along e_x, touching it at rest, that move
+    toward its axis by the level load w [m] each (``obs_v``: the upper one's vertices)."""
+    from tightknot.loading.levels import LevelLoad
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    d0 = diameter
+    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod += n_rod % 2  # even: a vertex at z = 0
+    n_obs = 4 * EDGES_PER_D0
+    half = 0.5 * length_over_d0 * d0
+    mat = Material(youngs_modulus, 0.5, DENSITY)
+    b = RodBuilder(twist=False)
+    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0,
+              Material(youngs_modulus, poisson_ratio, DENSITY))
+    for sign in (1.0, -1.0):  # indenters above and below, touching at rest
+        b.add_rod(_line_points(np.array([-2 * d0, sign * d0, 0]),
+                               np.array([2 * d0, sign * d0, 0]), n_obs), d0, mat)
+    model = b.finalize()
+    load = LevelLoad()
+    bcs = BoundaryConditions(model)
+    for rod, sign in ((1, 1.0), (2, -1.0)):
+        for k in range(n_obs + 1):
+            bcs.pin(rod, k, translation=lambda t, s=sign: np.array([0.0, -s * load(t), 0.0]))
+    mid = n_rod // 2
+    for k in range(n_rod + 1):
+        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
+    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
+    # rigid tilt about x is force-free between two crossing cylinders: gauge it at the
+    # ends (their reactions vanish by the up-down symmetry)
+    bcs.fix_components(0, 0, (1,))
+    bcs.fix_components(0, -1, (1,))
+    system = RodSystem(model, State.initial(model), bcs)
+    return RodScene(system, load, n_rod, n_obs, mid, half, _vertices(model, 0, n_rod),
+                    _vertices(model, 1, n_obs))
+
+
+#: The wrap's initial overlap over D0: the rod floats on the contact (see scenes.wrap).
+WRAP_START_OVERLAP: float = 0.01
+
+
+def wrap_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
+               wrap_angle_deg: float) -> RodScene:
+    """The wrap scene's rods and constraints: a rod (axis e_z at rest) pulled by dead end
+    forces, the level load T [N] times (0, sin(theta), +-cos(theta)), around a pinned rod
+    along e_x above it at y = D0 - ``WRAP_START_OVERLAP`` D0 (:func:`wrap_constraints`)."""
+    from tightknot.loading.levels import LevelLoad
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    d0 = diameter
+    theta = 0.5 * math.radians(wrap_angle_deg)
+    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod += n_rod % 2
+    n_obs = 4 * EDGES_PER_D0
+    half = 0.5 * length_over_d0 * d0
+    y_obs = d0 - WRAP_START_OVERLAP * d0
+    mat = Material(youngs_modulus, 0.5, DENSITY)
+    b = RodBuilder(twist=False)
+    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
+    b.add_rod(_line_points(np.array([-2 * d0, y_obs, 0]), np.array([2 * d0, y_obs, 0]),
+                           n_obs), d0, mat)
+    model = b.finalize()
+    load = LevelLoad()
+    bcs = BoundaryConditions(model)
+    for k in range(n_obs + 1):
+        bcs.pin(1, k)
+    mid = wrap_constraints(bcs, n_rod, theta, load)
+    system = RodSystem(model, State.initial(model), bcs)
+    return RodScene(system, load, n_rod, n_obs, mid, half, _vertices(model, 0, n_rod),
+                    _vertices(model, 1, n_obs))
 
 
 def _solve_levels(system: Any, load: LevelLoad, levels: list[float],
@@ -92,48 +198,18 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
     """
     from tightknot.contact.law import RadialComplianceLaw
     from tightknot.contact.layer import ContactLayer
-    from tightknot.loading.levels import LevelLoad
-    from tightknot.rods.boundary import BoundaryConditions
-    from tightknot.rods.builder import RodBuilder
-    from tightknot.rods.material import Material
-    from tightknot.rods.state import State
-    from tightknot.solvers.system import RodSystem
 
     start = time.perf_counter()
     law = law or RadialComplianceLaw.from_json()
     pair_law = rigid_counterbody_law(law)
     d0 = diameter
-    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
-    n_rod += n_rod % 2  # even: a vertex at z = 0
-    n_obs = 4 * EDGES_PER_D0
-    half = 0.5 * length_over_d0 * d0
-    mat = Material(youngs_modulus, 0.5, DENSITY)
-    b = RodBuilder(twist=False)
-    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0,
-              Material(youngs_modulus, poisson_ratio, DENSITY))
-    for sign in (1.0, -1.0):  # indenters above and below, touching at rest
-        b.add_rod(_line_points(np.array([-2 * d0, sign * d0, 0]),
-                               np.array([2 * d0, sign * d0, 0]), n_obs), d0, mat)
-    model = b.finalize()
-    load = LevelLoad()
-    bcs = BoundaryConditions(model)
-    for rod, sign in ((1, 1.0), (2, -1.0)):
-        for k in range(n_obs + 1):
-            bcs.pin(rod, k, translation=lambda t, s=sign: np.array([0.0, -s * load(t), 0.0]))
-    mid = n_rod // 2
-    for k in range(n_rod + 1):
-        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
-    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
-    # rigid tilt about x is force-free between two crossing cylinders: gauge it at the
-    # ends (their reactions vanish by the up-down symmetry)
-    bcs.fix_components(0, 0, (1,))
-    bcs.fix_components(0, -1, (1,))
-    system = RodSystem(model, State.initial(model), bcs)
+    scene = indent_scene(diameter, youngs_modulus, length_over_d0, poisson_ratio)
+    system, load, model = scene.system, scene.load, scene.model
+    n_rod, mid, half = scene.n_rod, scene.mid, scene.half
     layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window,
                          thinning="edge" if radius_window > 0.0 else thinning)
     system.add_term(layer)
-    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
-    up_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+    rod_v, up_v = scene.rod_v, scene.obs_v
 
     def measure(w: float) -> dict[str, Any]:
         x = system.state.x
@@ -205,41 +281,19 @@ def rod_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     from tightknot.contact.law import RadialComplianceLaw
     from tightknot.contact.layer import ContactLayer
     from tightknot.knots.curvature import bergou_curvature
-    from tightknot.loading.levels import LevelLoad
-    from tightknot.rods.boundary import BoundaryConditions
-    from tightknot.rods.builder import RodBuilder
-    from tightknot.rods.material import Material
-    from tightknot.rods.state import State
-    from tightknot.solvers.system import RodSystem
 
     start = time.perf_counter()
     law = law or RadialComplianceLaw.from_json()
     pair_law = rigid_counterbody_law(law)
     d0 = diameter
-    theta = 0.5 * math.radians(wrap_angle_deg)
-    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
-    n_rod += n_rod % 2
-    n_obs = 4 * EDGES_PER_D0
-    half = 0.5 * length_over_d0 * d0
-    s0 = 0.01 * d0  # initial overlap: the rod floats on the contact (see scenes.wrap)
-    y_obs = d0 - s0
-    mat = Material(youngs_modulus, 0.5, DENSITY)
-    b = RodBuilder(twist=False)
-    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
-    b.add_rod(_line_points(np.array([-2 * d0, y_obs, 0]), np.array([2 * d0, y_obs, 0]),
-                           n_obs), d0, mat)
-    model = b.finalize()
-    load = LevelLoad()
-    bcs = BoundaryConditions(model)
-    for k in range(n_obs + 1):
-        bcs.pin(1, k)
-    mid = wrap_constraints(bcs, n_rod, theta, load)
-    system = RodSystem(model, State.initial(model), bcs)
+    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg)
+    system, load, model = scene.system, scene.load, scene.model
+    n_rod, mid, half = scene.n_rod, scene.mid, scene.half
+    y_obs = d0 - WRAP_START_OVERLAP * d0
     layer = ContactLayer(model, pair_law, gauss_points=2, radius_window=radius_window,
                          thinning="edge" if radius_window > 0.0 else thinning)
     system.add_term(layer)
-    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
-    obs_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+    rod_v, obs_v = scene.rod_v, scene.obs_v
 
     def measure(tension: float) -> dict[str, Any]:
         x = system.state.x

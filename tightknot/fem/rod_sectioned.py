@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from .material import ROD_DIAMETER, YOUNGS_MODULUS
-from .rod_model import DENSITY, EDGES_PER_D0, _line_points, _solve_levels, wrap_constraints
+from .rod_model import WRAP_START_OVERLAP, _solve_levels, indent_scene, wrap_scene
 
 
 def _layer(model: Any, section: Any, rigid_rods: tuple[int, ...]) -> Any:
@@ -51,41 +51,14 @@ def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
     level (``section``: its :class:`~tightknot.contact.sectioned.SectionSettings`). Per
     level: ``force`` [N] on the upper indenter, ``area_ratio_mid``, ``peak_pressure_over_e``,
     ``contact_width_fraction_mid`` (both indenters' contacts), ``axial_stretch_mid``."""
-    from tightknot.loading.levels import LevelLoad
-    from tightknot.rods.boundary import BoundaryConditions
-    from tightknot.rods.builder import RodBuilder
-    from tightknot.rods.material import Material
-    from tightknot.rods.state import State
-    from tightknot.solvers.system import RodSystem
-
     start = time.perf_counter()
     d0 = diameter
-    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
-    n_rod += n_rod % 2  # even: a vertex at z = 0
-    n_obs = 4 * EDGES_PER_D0
-    half = 0.5 * length_over_d0 * d0
-    mat = Material(youngs_modulus, 0.5, DENSITY)
-    b = RodBuilder(twist=False)
-    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
-    for sign in (1.0, -1.0):  # indenters above and below, touching at rest
-        b.add_rod(_line_points(np.array([-2 * d0, sign * d0, 0]),
-                               np.array([2 * d0, sign * d0, 0]), n_obs), d0, mat)
-    model = b.finalize()
-    load = LevelLoad()
-    bcs = BoundaryConditions(model)
-    for rod, sign in ((1, 1.0), (2, -1.0)):
-        for k in range(n_obs + 1):
-            bcs.pin(rod, k, translation=lambda t, s=sign: np.array([0.0, -s * load(t), 0.0]))
-    mid = n_rod // 2
-    for k in range(n_rod + 1):
-        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
-    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
-    bcs.fix_components(0, 0, (1,))  # rigid tilt about x is force-free: gauged at the ends
-    bcs.fix_components(0, -1, (1,))
-    system = RodSystem(model, State.initial(model), bcs)
+    scene = indent_scene(diameter, youngs_modulus, length_over_d0)
+    system, load, model = scene.system, scene.load, scene.model
+    n_rod, mid, half = scene.n_rod, scene.mid, scene.half
     layer = _layer(model, section, (1, 2))
     system.add_term(layer)
-    up_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+    up_v = scene.obs_v
     rod_v0 = model.rods[0].vertex_start
 
     def measure(w: float) -> dict[str, Any]:
@@ -176,38 +149,16 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
     ``approach_over_d0`` (of the nominal axis), ``area_ratio_mid``,
     ``peak_pressure_over_e``, ``contact_width_fraction_mid``, ``contact_force_total``."""
     from tightknot.knots.curvature import bergou_curvature
-    from tightknot.loading.levels import LevelLoad
-    from tightknot.rods.boundary import BoundaryConditions
-    from tightknot.rods.builder import RodBuilder
-    from tightknot.rods.material import Material
-    from tightknot.rods.state import State
-    from tightknot.solvers.system import RodSystem
 
     start = time.perf_counter()
     d0 = diameter
-    theta = 0.5 * math.radians(wrap_angle_deg)
-    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
-    n_rod += n_rod % 2
-    n_obs = 4 * EDGES_PER_D0
-    half = 0.5 * length_over_d0 * d0
-    s0 = 0.01 * d0  # initial overlap: the rod floats on the contact (see scenes.wrap)
-    y_obs = d0 - s0
-    mat = Material(youngs_modulus, 0.5, DENSITY)
-    b = RodBuilder(twist=False)
-    b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
-    b.add_rod(_line_points(np.array([-2 * d0, y_obs, 0]), np.array([2 * d0, y_obs, 0]),
-                           n_obs), d0, mat)
-    model = b.finalize()
-    load = LevelLoad()
-    bcs = BoundaryConditions(model)
-    for k in range(n_obs + 1):
-        bcs.pin(1, k)
-    mid = wrap_constraints(bcs, n_rod, theta, load)
-    system = RodSystem(model, State.initial(model), bcs)
+    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg)
+    system, load, model = scene.system, scene.load, scene.model
+    n_rod, mid, half = scene.n_rod, scene.mid, scene.half
+    y_obs = d0 - WRAP_START_OVERLAP * d0
     layer = _layer(model, section, (1,))
     system.add_term(layer)
-    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
-    obs_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+    rod_v, obs_v = scene.rod_v, scene.obs_v
 
     def measure(tension: float) -> dict[str, Any]:
         x = system.state.x
