@@ -55,6 +55,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from tightknot.contact.section_squeeze import rounded_penalty
+
 
 def skew(v: NDArray) -> NDArray:
     """The matrix of v x . (3, 3)."""
@@ -123,19 +125,6 @@ def partition_weight(v: NDArray, first_open: bool, last_open: bool
     w1 = np.where(low_side, lo_1, np.where(high_side, -hi_1, 0.0))
     w2 = np.where(low_side, lo_2, np.where(high_side, -hi_2, 0.0))
     return w, w1, w2
-
-
-def rounded_penalty(pen: NDArray, kappa: NDArray | float, onset: float
-                    ) -> tuple[NDArray, NDArray, NDArray]:
-    """kappa pen^2 / 2 with its first ``onset`` [m] rounded into a cubic (C2 where a sample
-    enters contact), and its first two derivatives in pen (energy per area [J/m^2])."""
-    g = np.maximum(pen, 0.0)
-    low = g < onset
-    phi = np.where(low, kappa * g**3 / (6.0 * onset),
-                   kappa * (0.5 * g**2 - 0.5 * onset * g + onset**2 / 6.0))
-    dphi = np.where(low, kappa * g**2 / (2.0 * onset), kappa * (g - 0.5 * onset))
-    d2phi = np.where(low, kappa * g / onset, kappa)
-    return phi, dphi, d2phi
 
 
 @dataclass
