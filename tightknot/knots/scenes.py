@@ -215,6 +215,16 @@ def check_twist(twist: object) -> bool:
     return bool(twist)
 
 
+def minimum_nodes(pts: np.ndarray, closed: bool, d0: float) -> int:
+    """The fewest vertices [count] a start curve like ``pts`` [m] (any resolution) can be
+    resampled to with every edge within pi D0/4 (:func:`_check_edge_length`); 10 % above the
+    bare count, since a start grows a little with the resolution (finer polygons bend
+    tighter)."""
+    e = np.linalg.norm((np.roll(pts, -1, axis=0) - pts) if closed else np.diff(pts, axis=0),
+                       axis=1)
+    return int(math.ceil(1.1 * e.sum() / (0.25 * math.pi * d0))) + (0 if closed else 1)
+
+
 def _check_edge_length(pts: np.ndarray, closed: bool, d0: float, nodes: int,
                        contact: str) -> None:
     """Refuse a start whose edges exceed pi D0/4, half the contact layer's exclusion window
@@ -224,12 +234,10 @@ def _check_edge_length(pts: np.ndarray, closed: bool, d0: float, nodes: int,
         return
     e = np.linalg.norm((np.roll(pts, -1, axis=0) - pts) if closed else np.diff(pts, axis=0),
                        axis=1)
-    limit = 0.25 * math.pi * d0
-    if e.max() > limit:
-        # The start grows a little with the resolution (finer polygons bend tighter): 10 %.
-        need = int(math.ceil(1.1 * e.sum() / limit)) + (0 if closed else 1)
-        raise ValueError(f"nodes must be about >= {need} for this knot (the start's edges "
-                         f"are {e.max() / d0:.3g} D0 long, above pi/4 D0), got {nodes!r}")
+    if e.max() > 0.25 * math.pi * d0:
+        raise ValueError(f"nodes must be about >= {minimum_nodes(pts, closed, d0)} for this "
+                         f"knot (the start's edges are {e.max() / d0:.3g} D0 long, above "
+                         f"pi/4 D0), got {nodes!r}")
 
 
 def contact_name(contact: str | SectionSettings) -> str:

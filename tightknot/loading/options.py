@@ -270,8 +270,10 @@ class LoadPath:
     relax_iterations: int = param(2000, Range(1, 1_000_000), "",
                                   "Newton budget of the start curve's relaxation")
     coarse_nodes: int | None = param(None, Range(24, 200_000), "",
-                                     "mesh continuation: tie at this many vertices first, "
-                                     "then refine by doubling (tightknot.loading.refine)",
+                                     "mesh continuation: tie at this many vertices first "
+                                     "(at least as many as keep the start's edges within "
+                                     "pi/4 D0), then refine by doubling "
+                                     "(tightknot.loading.refine)",
                                      default_text=f"{REFINE_FROM} for a rod of more than "
                                      f"{3 * REFINE_FROM // 2} vertices, else off", metavar="N")
 

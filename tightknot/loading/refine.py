@@ -19,11 +19,12 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 
 import numpy as np
 
 from tightknot.knots import curves
-from tightknot.knots.scenes import KnotScene, end_vertex, gauge, rotate_to_axes
+from tightknot.knots.scenes import KnotScene, end_vertex, gauge, minimum_nodes, rotate_to_axes
 from tightknot.loading.options import LoadPath
 from tightknot.loading.tie import StepHook, TieResult, knot_type_of, tie
 from tightknot.rods.state import State
@@ -49,14 +50,9 @@ def carry(x: np.ndarray, closed: bool, nodes: int) -> np.ndarray:
     return curves.resample_equal_chords(x, nodes)
 
 
-def resolve(scene: KnotScene, start: np.ndarray, coarse: TieResult,
-            pull_force: float | None, residual_tol: float,
-            hook: StepHook | None = None) -> Coroutine[TieResult]:
-    """The equilibrium of ``scene`` (the fine rod, at its rest length L0) from the carried
-    centerline ``start`` [m], under the last load of the coarse load path ``coarse``: the
-    dead force ``pull_force`` [N] on the sliding end, or (None) the end held where the
-    coarse path left it; one static solve, the knot type checked."""
-    t0 = time.perf_counter()
+def _system_at(scene: KnotScene, start: np.ndarray, pull_force: float | None) -> RodSystem:
+    """The system of ``scene`` (at its rest length L0) from the carried centerline ``start``
+    [m] under the coarse path's last load (:func:`resolve`)."""
     model = scene.model
     shrink = 1.0 / scene.start_length_ratio
     if scene.closed:
@@ -76,6 +72,31 @@ def resolve(scene: KnotScene, start: np.ndarray, coarse: TieResult,
     system.add_term(scene.contact)
     system.history = []
     system.set_load(1.0)
+    return system
+
+
+def carried_failure(scene: KnotScene, res: TieResult, pull_force: float | None
+                    ) -> TieResult:
+    """A failed stage of the mesh continuation (``res``, on a coarser copy of ``scene``)
+    as a result on the scene's own rod: its last equilibrium carried to the scene's vertex
+    count, not solved again, so that a run saves and measures the scene's rod."""
+    n = res.system.model.vertex_count
+    start = carry(res.system.state.x, scene.closed, scene.model.vertex_count)
+    system = _system_at(scene, start, pull_force)
+    return replace(res, failure=f"at {n} vertices (mesh continuation): {res.failure}",
+                   system=system, failed_state=None)
+
+
+def resolve(scene: KnotScene, start: np.ndarray, coarse: TieResult,
+            pull_force: float | None, residual_tol: float,
+            hook: StepHook | None = None) -> Coroutine[TieResult]:
+    """The equilibrium of ``scene`` (the fine rod, at its rest length L0) from the carried
+    centerline ``start`` [m], under the last load of the coarse load path ``coarse``: the
+    dead force ``pull_force`` [N] on the sliding end, or (None) the end held where the
+    coarse path left it; one static solve, the knot type checked."""
+    t0 = time.perf_counter()
+    model = scene.model
+    system = _system_at(scene, start, pull_force)
     # One step: the loads do not change with t, so a halved step solves the same problem
     # again from where the last attempt was put back. The carried shape is near, not at,
     # the fine rod's equilibrium, and a loose knot's is a long floppy way off: a larger
@@ -111,15 +132,27 @@ def tie_refined(scene: KnotScene, coarse_nodes: int, target_lambda: float | None
     (:func:`tightknot.loading.tie.tie` with ``tie_options``, or
     :func:`tightknot.loading.pull.tie_to_lambda` to ``target_lambda``) on the same scene
     at ``coarse_nodes`` vertices, then refined by doubling to the scene's own count, each
-    refinement one static solve under the coarse path's last load. A program
-    (:mod:`tightknot.solvers.program`); the result's system is the scene's own model, and
-    a ``hook`` in ``tie_options`` sees its final solve only."""
+    refinement one static solve under the coarse path's last load. The coarse count is
+    raised to the fewest vertices the scene's start allows with contact
+    (:func:`tightknot.knots.scenes.minimum_nodes`: edges within pi D0/4); where that is
+    the scene's own count there is no coarser stage and the load path runs on the scene.
+    A program (:mod:`tightknot.solvers.program`); the result's system is the scene's own
+    model, and a ``hook`` in ``tie_options`` sees its final solve only."""
     if scene.rebuild is None:
         raise ValueError(f"{scene.name}: this scene cannot be rebuilt at another resolution "
                          "(mesh continuation needs the scene's rebuild)")
-    counts = refinements(int(coarse_nodes), scene.model.vertex_count)
     if target_lambda is not None and scene.closed:
         raise ValueError("target_lambda is for open knots")
+    if scene.contact is not None:
+        coarse_nodes = max(int(coarse_nodes),
+                           minimum_nodes(scene.state.x, scene.closed, scene.diameter))
+    if coarse_nodes >= scene.model.vertex_count:
+        from tightknot.loading.pull import tie_to_lambda
+
+        if target_lambda is not None:
+            return tie_to_lambda(scene, target_lambda, **tie_options)
+        return tie(scene, **tie_options)
+    counts = refinements(int(coarse_nodes), scene.model.vertex_count)
     # The fine rod's end: pulled by the coarse path's final force, or (an end distance, or
     # a tightening without a pull) held where the coarse path left it.
     pull_force = tie_options.get("pull_force")
@@ -146,7 +179,7 @@ def _tie_refined(scene: KnotScene, counts: list[int], coarse_nodes: int,
         force = pull_force
     for n in counts:
         if not res.converged:
-            return res
+            return carried_failure(scene, res, None if force is None else float(force))
         fine = scene if n == scene.model.vertex_count else scene.rebuild(n)
         start = carry(res.system.state.x, scene.closed, n)
         res = yield from resolve(fine, start, res, None if force is None else float(force),

@@ -208,8 +208,10 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
         residual_tol=residual_tol, max_iterations=relax_iterations))
     iters += relax.iterations
     if not relax.converged:
-        return fail(f"relax: Newton {relax.reason} (residual {relax.residual:.3g}) at the start",
-                    system, hold)
+        hint = ("; the loose start of a long rod may need more: raise relax_iterations, "
+                f"{relax_iterations} now" if relax.reason == "max_iterations" else "")
+        return fail(f"relax: Newton {relax.reason} (residual {relax.residual:.3g}) at the "
+                    f"start{hint}", system, hold)
     kt = knot_type(scene, system.state.x)
     types.append(kt)
     if kt != scene.knot_type:
