@@ -201,6 +201,49 @@ def test_step_bound_prevents_passing_through() -> None:
     assert cl.max_step(x, -dx, m.edge_rest_length) == 1.0
 
 
+def test_a_step_too_long_for_the_broad_phase_is_cut_and_stays_safe(monkeypatch) -> None:
+    # Rod 1 crosses a long rod 0 1.2 D above it; a step moves it 300 D along rod 0 and 300 D
+    # down, sweeping its bounds over all of rod 0. With the broad phase's limit lowered
+    # below that sweep's candidates (and above those of a 20 D sweep), the bound first cuts
+    # the step to STEP_REACH diameters; without the cut the query overflowed and raised (a
+    # floppy start's first Newton steps on a rod of 1e4 D0 stopped the run so, exit 2).
+    # The fraction is then that of the cut step: at most the reach, and safe.
+    from tightknot.contact import broad_phase, step_bound
+    from tightknot.contact.broad_phase import ContactCapacityError
+
+    b = RodBuilder(twist=False)
+    s0 = np.linspace(-20 * D, 180 * D, 401)  # edges of 0.5 D
+    b.add_rod(np.c_[s0, 0 * s0, 0 * s0], D, Material(E, 0.5, 1160.0))
+    s1 = np.linspace(-3 * D, 3 * D, 13)
+    b.add_rod(np.c_[0 * s1, s1, 0 * s1 + 1.2 * D], D, Material(E, 0.5, 1160.0))
+    m = b.finalize()
+    x = m.vertex_initial_position
+    dx = np.zeros_like(x)
+    dx[m.rods[1].vertex_slice] = [300.0 * D, 0.0, -300.0 * D]
+
+    def count(step: np.ndarray) -> int:
+        cl = ContactLayer(m, LAW, hard_fraction=0.1)
+        bp = cl.broad_phase
+        return bp.candidates(bp.x_in.put(x), bp.dx_in.put(step), cl.step_bound.half_hard,
+                             *bp.arcs(m.edge_rest_length), window=0.0).shape[0]
+
+    reach = step_bound.STEP_REACH / (300.0 * math.sqrt(2.0))
+    far, near = count(dx), count(reach * dx)
+    assert far > 4 * near  # the sweep over rod 0 is what overflows (722 against 60 pairs)
+    monkeypatch.setattr(broad_phase, "MAX_CANDIDATES", (far + near) // 2)
+    cl = ContactLayer(m, LAW, hard_fraction=0.1, initial_capacity=1)
+    alpha = cl.max_step(x, dx, m.edge_rest_length)
+    assert 0.0 < alpha <= reach * (1 + 1e-12)
+    monkeypatch.setattr(broad_phase, "MAX_CANDIDATES", 10**9)  # the check's own query
+    dist, _, _ = cl.min_distance(x + alpha * dx)
+    assert dist >= 0.1 * D * (1 - 1e-9)
+    # A step within the reach that still overflows is a dense contact set: an error.
+    monkeypatch.setattr(broad_phase, "MAX_CANDIDATES", 1)
+    fresh = ContactLayer(m, LAW, hard_fraction=0.1, initial_capacity=1)
+    with pytest.raises(ContactCapacityError):
+        fresh.max_step(x, reach * dx, m.edge_rest_length)
+
+
 def test_start_that_intersects_itself_is_refused_with_arc_lengths() -> None:
     m = two_rods(90.0, 0.05 * D, n=21, length=6 * D)
     cl = ContactLayer(m, LAW, hard_fraction=0.1)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from tightknot.contact.broad_phase import BroadPhase, arc_separation
+from tightknot.contact.broad_phase import BroadPhase, ContactCapacityError, arc_separation
 from tightknot.contact.kernel_module import KERNEL_MODULE
 from tightknot.rods.staging import Launches, Output
 
@@ -26,6 +26,12 @@ f64 = wp.float64
 
 #: Floor of near pairs of one rod over the tightest legal bend's chord (module docstring).
 LOCAL_FRACTION = 0.25
+
+#: Longest vertex move, over the largest rest diameter, a step is cut to when its swept
+#: bounds hold more candidate pairs than the broad phase allows (a floppy start's first
+#: Newton steps move thousands of diameters on a rod of 1e4 D0 and sweep their edges over
+#: much of the rod): a smaller fraction of a step is always safe.
+STEP_REACH = 20.0
 HALF_PI = wp.constant(wp.float64(1.5707963267948966))
 
 
@@ -152,6 +158,8 @@ class StepBound:
         self.local_fraction = float(local_fraction)
         self._diameter = wp.array(np.asarray(edge_diameter, dtype=np.float64), dtype=f64,
                                   device=dev)
+        #: The largest rest diameter [m] (the unit of :data:`STEP_REACH`).
+        self._dmax = float(np.max(edge_diameter))
         #: Hard limit of each edge [m] (host).
         self.edge_hard = np.asarray(edge_hard, dtype=np.float64)
         self._hard = wp.array(self.edge_hard, dtype=f64, device=dev)
@@ -164,17 +172,27 @@ class StepBound:
     def max_step(self, x: np.ndarray, dx: np.ndarray, rest: np.ndarray) -> float:
         """Largest fraction of the step ``dx`` [m] (vertices) from positions ``x`` [m] that
         keeps every segment pair sharing no vertex at least its floor apart along the
-        straight path (1 = full); ``rest``: edge rest lengths [m] (the arcs of the near
-        pairs' floors, :meth:`BroadPhase.arcs`)."""
+        straight path (1 = full; a step whose candidates overflow the broad phase is first
+        cut to :data:`STEP_REACH` diameters); ``rest``: edge rest lengths [m] (the arcs of
+        the near pairs' floors, :meth:`BroadPhase.arcs`)."""
         broad = self.broad
         wx = broad.x_in.put(x)
         wdx = broad.dx_in.put(dx)
         arcs, rod_len = broad.arcs(rest)
-        pairs = broad.candidates(wx, wdx, self.half_hard, arcs, rod_len, window=0.0)
+        cut = 1.0
+        try:
+            pairs = broad.candidates(wx, wdx, self.half_hard, arcs, rod_len, window=0.0)
+        except ContactCapacityError:
+            longest = float(np.sqrt(np.max(np.sum(dx * dx, axis=1))))
+            if longest <= STEP_REACH * self._dmax:
+                raise  # a dense contact set, not a long step
+            cut = STEP_REACH * self._dmax / longest
+            wdx = broad.dx_in.put(cut * dx)
+            pairs = broad.candidates(wx, wdx, self.half_hard, arcs, rod_len, window=0.0)
         if pairs.shape[0] == 0:
-            return 1.0
+            return cut
         alpha = self.pair_bounds(wx, wdx, pairs, arcs, rod_len)
-        return float(np.clip(alpha.min(), 0.0, 1.0))
+        return cut * float(np.clip(alpha.min(), 0.0, 1.0))
 
     def pair_bounds(self, wx: wp.array, wdx: wp.array, pairs: wp.array, arcs: wp.array,
                     rod_len: wp.array) -> np.ndarray:
