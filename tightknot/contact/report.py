@@ -141,22 +141,9 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
         vb = np.where(t < 0.5, ev[b, 0], ev[b, 1])
         pair_list = np.c_[va, vb, 2.0 * w]
     # Edge -> vertex: the larger of the vertex's edges.
-    def to_vertex(val: np.ndarray) -> np.ndarray:
-        out = np.zeros(n)
-        np.maximum.at(out, ev[:, 0], val)
-        np.maximum.at(out, ev[:, 1], val)
-        return out
-
-    stretch_v = np.zeros(n)
-    cnt = np.zeros(n)
-    np.add.at(stretch_v, ev[:, 0], stretch_e)
-    np.add.at(stretch_v, ev[:, 1], stretch_e)
-    np.add.at(cnt, ev[:, 0], 1.0)
-    np.add.at(cnt, ev[:, 1], 1.0)
-    stretch_v /= np.maximum(cnt, 1.0)
-    dv = np.zeros(n)
-    np.maximum.at(dv, ev[:, 0], d0)
-    np.maximum.at(dv, ev[:, 1], d0)
+    to_vertex = m.vertex_max_of_edges
+    stretch_v = m.vertex_mean_of_edges(stretch_e)
+    dv = to_vertex(d0)
     w1v, w2v, xiv = to_vertex(w1), to_vertex(w2), to_vertex(xi_e)
     emod = np.array([m.rods[r].material.youngs_modulus for r in m.vertex_rod])
     f_line = law.k_line * emod * dv * (w1v / dv) ** law.p_line / emod  # f/E [m]
@@ -178,7 +165,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
         if state is None:
             raise ValueError("the sectioned contact level's report needs the state (its "
                              "sections)")
-        sec = layer.section_report(x, state.extra, (state.t_ref, state.d1_ref, state.m_ref),
+        sec = layer.section_report(x, state.extra, state.frames,
                                    rest)
         half, lc, area = sec["half_width"], sec["contact_width_fraction"], sec["area_ratio"]
         p_mean, p_peak = sec["mean_pressure_over_E"], sec["peak_pressure_over_E"]

@@ -597,18 +597,8 @@ class SectionedLayer(ContactLayer):
         area_s = self.edge_r0 * 2.0 * math.pi / ms  # rest area per unit rest length
         f_len = area_s * np.einsum("egs,g->e", press, g_w)
 
-        def to_vertex(val: np.ndarray) -> np.ndarray:
-            out = np.zeros(n_v)
-            np.maximum.at(out, ev[:, 0], val)
-            np.maximum.at(out, ev[:, 1], val)
-            return out
-
-        stretch_v = np.zeros(n_v)
-        count = np.zeros(n_v)
-        for side in (0, 1):
-            np.add.at(stretch_v, ev[:, side], lam)
-            np.add.at(count, ev[:, side], 1.0)
-        stretch_v /= np.maximum(count, 1.0)
+        to_vertex = m.vertex_max_of_edges
+        stretch_v = m.vertex_mean_of_edges(lam)
         nu_v = np.zeros(n_v)
         nu_v[ev[:, 0]] = self.edge_nu
         nu_v[ev[:, 1]] = self.edge_nu

@@ -183,3 +183,23 @@ class Model:
     def rest_length(self, rod: int = 0) -> float:
         """Rest length L0 of rod ``rod`` [m]."""
         return float(self.edge_rest_length[self.rods[rod].edge_slice].sum())
+
+    def vertex_max_of_edges(self, values: np.ndarray) -> np.ndarray:
+        """Per vertex, the largest of its edges' ``values`` (non-negative; 0 for a vertex
+        without edges)."""
+        ev = self.edge_vertex
+        out = np.zeros(self.vertex_count)
+        np.maximum.at(out, ev[:, 0], values)
+        np.maximum.at(out, ev[:, 1], values)
+        return out
+
+    def vertex_mean_of_edges(self, values: np.ndarray) -> np.ndarray:
+        """Per vertex, the mean of its edges' ``values`` (0 for a vertex without edges)."""
+        ev = self.edge_vertex
+        total = np.zeros(self.vertex_count)
+        count = np.zeros(self.vertex_count)
+        np.add.at(total, ev[:, 0], values)
+        np.add.at(total, ev[:, 1], values)
+        np.add.at(count, ev[:, 0], 1.0)
+        np.add.at(count, ev[:, 1], 1.0)
+        return total / np.maximum(count, 1.0)
