@@ -24,7 +24,13 @@ from typing import Any
 import numpy as np
 
 from .material import ROD_DIAMETER, YOUNGS_MODULUS
-from .rod_model import DENSITY, EDGES_PER_D0, _line_points, _solve_levels, wrap_constraints
+from .rod_model import (
+    DENSITY,
+    EDGES_PER_D0,
+    WRAP_START_OVERLAP,
+    _solve_levels,
+    wrap_scene,
+)
 
 CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed", "sectioned")
 """Contact levels of the rod model here (:func:`contact_term`)."""
@@ -89,35 +95,19 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     and ``area_ratio_mid_b``, ``profile_a``, ``profile_b``; and the wall time.
     """
     from tightknot.knots.curvature import bergou_curvature
-    from tightknot.loading.levels import LevelLoad
-    from tightknot.rods.boundary import BoundaryConditions
-    from tightknot.rods.state import State
-    from tightknot.solvers.system import RodSystem
 
     start = time.perf_counter()
     check_contact(contact)
     d0 = diameter
-    theta = 0.5 * math.radians(wrap_angle_deg)
-    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
-    n_rod += n_rod % 2
-    n_obs = 4 * EDGES_PER_D0
-    half = 0.5 * length_over_d0 * d0
-    s0 = 0.01 * d0  # initial overlap: A floats on the contact (see scenes.wrap)
-    y_obs = d0 - s0
-    model = _builder_rod((_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod),
-                          _line_points(np.array([-2 * d0, y_obs, 0]),
-                                       np.array([2 * d0, y_obs, 0]), n_obs)),
-                         d0, youngs_modulus)
-    load = LevelLoad()
-    bcs = BoundaryConditions(model)
-    for k in range(n_obs + 1):
-        bcs.pin(1, k)
-    mid = wrap_constraints(bcs, n_rod, theta, load)
-    system = RodSystem(model, State.initial(model), bcs)
+    # The rigid wrap's rods and constraints (B pinned: the FEM's stack keeps its axis
+    # straight); only the pair law differs.
+    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg)
+    system, load, model = scene.system, scene.load, scene.model
+    n_rod, n_obs, mid, half = scene.n_rod, scene.n_obs, scene.mid, scene.half
+    y_obs = d0 - WRAP_START_OVERLAP * d0
     term = contact_term(model, contact, law)
     system.add_term(term)
-    rod_v = np.arange(model.rods[0].vertex_start, model.rods[0].vertex_start + n_rod + 1)
-    obs_v = np.arange(model.rods[1].vertex_start, model.rods[1].vertex_start + n_obs + 1)
+    rod_v, obs_v = scene.rod_v, scene.obs_v
     s_a = np.linspace(-half, half, n_rod + 1)
     s_b = np.linspace(-2 * d0, 2 * d0, n_obs + 1)
 
