@@ -34,14 +34,7 @@ def _layer(model: Any, section: Any, rigid_rods: tuple[int, ...]) -> Any:
 
 def _report(layer: Any, system: Any) -> dict[str, np.ndarray]:
     st = system.state
-    return layer.section_report(st.x, st.extra, (st.t_ref, st.d1_ref, st.m_ref), system.rest)
-
-
-def _contact_gradient(layer: Any, system: Any) -> np.ndarray:
-    """The contact's gradient over positions [N] (vertex_count, 3) at the state."""
-    st = system.state
-    return layer.contact_energy(st.x, st.extra, (st.t_ref, st.d1_ref, st.m_ref), system.rest,
-                                True, False)[1]
+    return layer.section_report(st.x, st.extra, st.frames, system.rest)
 
 
 def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
@@ -63,7 +56,7 @@ def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
 
     def measure(w: float) -> dict[str, Any]:
         x = system.state.x
-        force = -float(_contact_gradient(layer, system)[up_v, 1].sum())
+        force = -float(system.term_gradient(layer)[up_v, 1].sum())
         rep = _report(layer, system)
         e = np.linalg.norm(np.diff(x[rod_v0:rod_v0 + n_rod + 1], axis=0), axis=1)
         stretch = float(0.5 * (e[mid - 1] + e[mid]) / (2.0 * half / n_rod))
@@ -162,7 +155,7 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
 
     def measure(tension: float) -> dict[str, Any]:
         x = system.state.x
-        g = _contact_gradient(layer, system)
+        g = system.term_gradient(layer)
         total = float(np.linalg.norm(g[obs_v].sum(axis=0)))
         rep = _report(layer, system)
         xr = x[rod_v]

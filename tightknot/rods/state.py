@@ -89,6 +89,12 @@ class State:
             self.extra.copy(),
         )
 
+    @property
+    def frames(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The accepted frames (t_ref, d1_ref, m_ref) a term with dofs of its own is
+        evaluated with (:meth:`tightknot.rods.term.EnergyTerm.evaluate_with_dofs`)."""
+        return self.t_ref, self.d1_ref, self.m_ref
+
     def dofs(self, model: Model) -> np.ndarray:
         """Pack positions and twist angles into the model's dof vector."""
         q = np.empty(model.dof_count)

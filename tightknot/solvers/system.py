@@ -190,10 +190,7 @@ class RodSystem:
 
     def free_vector(self) -> np.ndarray:
         """The state's free dofs (then the dofs of a term that owns some, State.extra)."""
-        u = self.full_dofs()[self.pattern.free_dofs]
-        if self.dof_term is None:
-            return u
-        return np.concatenate([u, self.state.extra])
+        return self.free_vector_at(self.state.x)
 
     def free_vector_at(self, x: np.ndarray) -> np.ndarray:
         """:meth:`free_vector` with the positions ``x`` [m] in place of the state's."""
@@ -263,7 +260,7 @@ class RodSystem:
         for term in self.extra_terms:
             if term is self.dof_term:
                 e_k, g_k, g_own, h_own = term.evaluate_with_dofs(
-                    x, u[n_model:], (st.t_ref, st.d1_ref, st.m_ref), self.rest,
+                    x, u[n_model:], st.frames, self.rest,
                     want_grad or want_hess, want_hess)
                 split.extra[term.name] = e_k
                 if grad is not None and g_k is not None:
@@ -316,7 +313,7 @@ class RodSystem:
         extra terms at the state (a term with dofs of its own at the state's, State.extra)."""
         st = self.state
         if term is self.dof_term:
-            return term.evaluate_with_dofs(st.x, st.extra, (st.t_ref, st.d1_ref, st.m_ref),
+            return term.evaluate_with_dofs(st.x, st.extra, st.frames,
                                            self.rest, True, False)[1]
         return term.evaluate(st.x, self.rest, True, False)[1]
 
