@@ -215,14 +215,18 @@ def check_twist(twist: object) -> bool:
     return bool(twist)
 
 
+def _edge_lengths(pts: np.ndarray, closed: bool) -> np.ndarray:
+    return np.linalg.norm((np.roll(pts, -1, axis=0) - pts) if closed else np.diff(pts, axis=0),
+                          axis=1)
+
+
 def minimum_nodes(pts: np.ndarray, closed: bool, d0: float) -> int:
     """The fewest vertices [count] a start curve like ``pts`` [m] (any resolution) can be
     resampled to with every edge within pi D0/4 (:func:`_check_edge_length`); 10 % above the
     bare count, since a start grows a little with the resolution (finer polygons bend
     tighter)."""
-    e = np.linalg.norm((np.roll(pts, -1, axis=0) - pts) if closed else np.diff(pts, axis=0),
-                       axis=1)
-    return int(math.ceil(1.1 * e.sum() / (0.25 * math.pi * d0))) + (0 if closed else 1)
+    length = _edge_lengths(pts, closed).sum()
+    return int(math.ceil(1.1 * length / (0.25 * math.pi * d0))) + (0 if closed else 1)
 
 
 def _check_edge_length(pts: np.ndarray, closed: bool, d0: float, nodes: int,
@@ -232,11 +236,10 @@ def _check_edge_length(pts: np.ndarray, closed: bool, d0: float, nodes: int,
     become a contact pair, and their shared vertex would read as a self-intersection."""
     if contact == "off":
         return
-    e = np.linalg.norm((np.roll(pts, -1, axis=0) - pts) if closed else np.diff(pts, axis=0),
-                       axis=1)
-    if e.max() > 0.25 * math.pi * d0:
+    longest = _edge_lengths(pts, closed).max()
+    if longest > 0.25 * math.pi * d0:
         raise ValueError(f"nodes must be about >= {minimum_nodes(pts, closed, d0)} for this "
-                         f"knot (the start's edges are {e.max() / d0:.3g} D0 long, above "
+                         f"knot (the start's edges are {longest / d0:.3g} D0 long, above "
                          f"pi/4 D0), got {nodes!r}")
 
 
@@ -249,16 +252,12 @@ def check_contact(contact: str | SectionSettings, law: RadialComplianceLaw | Non
                   ) -> str | SectionSettings:
     """The ``contact`` model level, checked against :data:`CONTACT_LEVELS` and ``law`` (the
     settings of a sectioned level stand for "sectioned" and are returned as they are)."""
-    if isinstance(contact, SectionSettings):
-        if law is not None:
-            raise ValueError("contact='sectioned' takes no radial-compliance law: its contact "
-                             "is calibrated by the section's FEM calibration "
-                             "(tightknot/data/section_calibration.json)")
-        return contact
-    if contact == "sectioned" and law is not None:
+    if contact_name(contact) == "sectioned" and law is not None:
         raise ValueError("contact='sectioned' takes no radial-compliance law: its contact is "
                          "calibrated by the section's FEM calibration "
                          "(tightknot/data/section_calibration.json)")
+    if isinstance(contact, SectionSettings):
+        return contact
     if contact not in CONTACT_LEVELS:
         raise ValueError(f"contact must be one of {', '.join(CONTACT_LEVELS)}, got {contact!r}")
     if contact == "off" and law is not None:
