@@ -75,6 +75,23 @@ def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "section_modes": layer.section.max_mode, "penalty": layer.penalty}
 
 
+def _vertex_section(layer: Any, system: Any, v: int
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """Vertex ``v`` of rod 0 at the state: its frame's t, d1, d2 (of the edge that stores its
+    section), its section's coefficients [m] and mean radius R [m] (the area's, thinned by
+    the edge's stretch, incompressible)."""
+    st = system.state
+    m = layer.model
+    k = layer.section.coeff_count
+    last_edge = m.rods[0].edge_start + m.rods[0].edge_count - 1
+    e = min(v - m.rods[0].vertex_start + m.rods[0].edge_start, last_edge)
+    t, d1 = st.t_ref[e], st.d1_ref[e]
+    c = st.extra[layer.vertex_offset[v]:layer.vertex_offset[v] + k]
+    a, b = m.edge_vertex[e]
+    lam = float(np.linalg.norm(st.x[b] - st.x[a]) / system.rest[e])
+    return t, d1, np.cross(t, d1), c, math.sqrt(layer.edge_r0[e] ** 2 / lam - 0.5 * float(c @ c))
+
+
 def _far_fibre_axis(layer: Any, system: Any, verts: np.ndarray, axis_y: float,
                     r_stretched: float) -> np.ndarray:
     """The nominal axis at vertices ``verts`` of the wrapped rod (module docstring): the
@@ -83,23 +100,14 @@ def _far_fibre_axis(layer: Any, system: Any, verts: np.ndarray, axis_y: float,
     from tightknot.contact.sectioned_reference import mode_basis
 
     st = system.state
-    m = layer.model
-    k = layer.section.coeff_count
     out = np.empty((len(verts), 3))
-    last_edge = m.rods[0].edge_start + m.rods[0].edge_count - 1
     for i, v in enumerate(verts):
-        e = min(v - m.rods[0].vertex_start + m.rods[0].edge_start, last_edge)
-        t, d1 = st.t_ref[e], st.d1_ref[e]
-        d2 = np.cross(t, d1)
+        t, d1, d2, c, big_r = _vertex_section(layer, system, v)
         # the direction to the cylinder's axis (the x axis at y = axis_y), normal to t
         toward = np.array([0.0, axis_y - st.x[v, 1], -st.x[v, 2]])
         toward -= (toward @ t) * t
         away = -toward / np.linalg.norm(toward)
         phi = math.atan2(away @ d2, away @ d1)
-        c = st.extra[layer.vertex_offset[v]:layer.vertex_offset[v] + k]
-        a, b = m.edge_vertex[e]
-        lam = float(np.linalg.norm(st.x[b] - st.x[a]) / system.rest[e])
-        big_r = math.sqrt(layer.edge_r0[e] ** 2 / lam - 0.5 * float(c @ c))
         r = big_r + float(mode_basis(layer.modes, np.array([phi]))[0][0] @ c)
         out[i] = st.x[v] + (r - r_stretched) * away
     return out
@@ -112,20 +120,12 @@ def _centroid_axis(layer: Any, system: Any, verts: np.ndarray) -> np.ndarray:
     from tightknot.contact.sectioned_reference import mode_basis
 
     st = system.state
-    m = layer.model
-    k = layer.section.coeff_count
     phi = 2.0 * math.pi * (np.arange(720) + 0.5) / 720
     basis = mode_basis(layer.modes, phi)[0]
-    last_edge = m.rods[0].edge_start + m.rods[0].edge_count - 1
     out = np.empty((len(verts), 3))
     for i, v in enumerate(verts):
-        e = min(v - m.rods[0].vertex_start + m.rods[0].edge_start, last_edge)
-        t, d1 = st.t_ref[e], st.d1_ref[e]
-        d2 = np.cross(t, d1)
-        c = st.extra[layer.vertex_offset[v]:layer.vertex_offset[v] + k]
-        a, b = m.edge_vertex[e]
-        lam = float(np.linalg.norm(st.x[b] - st.x[a]) / system.rest[e])
-        r = math.sqrt(layer.edge_r0[e] ** 2 / lam - 0.5 * float(c @ c)) + basis @ c
+        _, d1, d2, c, big_r = _vertex_section(layer, system, v)
+        r = big_r + basis @ c
         area = 0.5 * float(np.mean(r * r)) * 2.0 * math.pi
         mx = float(np.mean(r**3 * np.cos(phi))) * 2.0 * math.pi / (3.0 * area)
         my = float(np.mean(r**3 * np.sin(phi))) * 2.0 * math.pi / (3.0 * area)
