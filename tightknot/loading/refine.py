@@ -26,6 +26,7 @@ import numpy as np
 from tightknot.knots import curves
 from tightknot.knots.scenes import KnotScene, end_vertex, gauge, minimum_nodes, rotate_to_axes
 from tightknot.loading.options import LoadPath
+from tightknot.loading.pull import tie_to_lambda
 from tightknot.loading.tie import StepHook, TieResult, knot_type_of, tie
 from tightknot.rods.state import State
 from tightknot.solvers.continuation import ContinuationOptions, StepRecord, continuation
@@ -147,8 +148,6 @@ def tie_refined(scene: KnotScene, coarse_nodes: int, target_lambda: float | None
         coarse_nodes = max(int(coarse_nodes),
                            minimum_nodes(scene.state.x, scene.closed, scene.diameter))
     if coarse_nodes >= scene.model.vertex_count:
-        from tightknot.loading.pull import tie_to_lambda
-
         if target_lambda is not None:
             return tie_to_lambda(scene, target_lambda, **tie_options)
         return tie(scene, **tie_options)
@@ -164,8 +163,6 @@ def _tie_refined(scene: KnotScene, counts: list[int], coarse_nodes: int,
                  target_lambda: float | None, pull_force: object,
                  tie_options: dict) -> Coroutine[TieResult]:
     """The coroutine of :func:`tie_refined`."""
-    from tightknot.loading.pull import tie_to_lambda
-
     coarse = scene.rebuild(int(coarse_nodes))
     # The hook sees the scene's own rod only (a run's log and its measures are of that
     # rod): the final refinement, not the coarse path.
