@@ -150,6 +150,13 @@ class RodSections:
                 "p_over_e": (p[on] / youngs_modulus).tolist()}
 
 
+def contact_half_length(profile: list[dict[str, float]]) -> float:
+    """Contact half-length along a rod [D0]: the rest position of its last loaded layer
+    (0 where none is loaded)."""
+    loaded = [r["s_over_d0"] for r in profile if r["contact_fraction"] > 0.0]
+    return max(loaded) if loaded else 0.0
+
+
 def _quad_areas(corners_of: np.ndarray, quads: np.ndarray) -> np.ndarray:
     """Areas [m^2] of quads with 3D corners (the diagonals' cross product: exact for a
     planar quad, the mean projected area of a warped one)."""

@@ -68,7 +68,7 @@ from ._common import (
     relative,
 )
 from ._pair import GAP_OVER_DHAT, bodies_solid, make_barrier, nodal_contact
-from ._sections import RodSections
+from ._sections import RodSections, contact_half_length
 
 REFINED_ARC_OVER_D0: float = 1.6
 """Arc length from the apex [D0] meshed uniformly: a rod wrapped around its partner's tube
@@ -304,9 +304,7 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
             "peak_pressure_b_over_e": float(pressure[idx_b].max()) / youngs_modulus,
             "contact_fraction_max": max(row["contact_fraction"] for row in prof_a),
             "contact_fraction_max_b": max(row["contact_fraction"] for row in prof_b),
-            "contact_half_length_over_d0": max([row["s_over_d0"] for row in prof_a
-                                                if row["contact_fraction"] > 0.0],
-                                               default=0.0),
+            "contact_half_length_over_d0": contact_half_length(prof_a),
             "min_gap_over_d0": contact.minimum_distance_over_scale(),
             "volume_ratio": volume_ratio(solid),
             "profile_a": prof_a,

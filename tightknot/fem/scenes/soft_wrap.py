@@ -60,7 +60,7 @@ from ._pair import (
     nodal_contact,
     turned_about_x_eq_z,
 )
-from ._sections import RodSections
+from ._sections import RodSections, contact_half_length
 
 GAP_OVER_DHAT: float = 0.5
 """Initial gap between the rods [dhat]: inside the barrier's activation distance, so that
@@ -250,7 +250,7 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
             "peak_pressure_over_e": float(pressure[idx_a].max()) / youngs_modulus,
             "peak_pressure_b_over_e": float(pressure[idx_b].max()) / youngs_modulus,
             "contact_half_width_mid_over_d0": b_mid / diameter,
-            "contact_half_length_over_d0": _half_length(prof_a),
+            "contact_half_length_over_d0": contact_half_length(prof_a),
             "contact_fraction_max": max(r["contact_fraction"] for r in prof_a),
             "contact_fraction_max_b": max(r["contact_fraction"] for r in prof_b),
             "min_gap_over_d0": contact.minimum_distance_over_scale(),
@@ -293,9 +293,3 @@ def _mid_curvature(bergou: Any, axis_yz_points: np.ndarray) -> float:
     pts = np.asarray(axis_yz_points)[:4]
     mirror = pts[1:4] * np.array([1.0, 1.0, -1.0])
     return float(bergou(np.vstack([mirror[::-1], pts]), closed=False)[3])
-
-
-def _half_length(profile: list[dict[str, float]]) -> float:
-    """Contact half-length along A [D0]: the rest position of the last loaded layer."""
-    loaded = [r["s_over_d0"] for r in profile if r["contact_fraction"] > 0.0]
-    return max(loaded) if loaded else 0.0
