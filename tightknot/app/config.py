@@ -70,10 +70,12 @@ class TieConfig(Output, LoadPath, StartFile, Scene):
         refine = {} if self.coarse_nodes is None else {"coarse_nodes": self.coarse_nodes}
         if self.target_lambda is not None:
             return {"target_lambda": self.target_lambda, "tolerance": self.lambda_tolerance,
-                    "residual_tol": self.residual_tol, **refine}
+                    "residual_tol": self.residual_tol, "section_path": self.section_path,
+                    **refine}
         opts: dict[str, Any] = {"tighten_steps": self.tighten_steps,
                                 "residual_tol": self.residual_tol,
-                                "relax_iterations": self.relax_iterations}
+                                "relax_iterations": self.relax_iterations,
+                                "section_path": self.section_path}
         if self.knot == "open":
             opts.update(pull_steps=self.pull_steps, pull_force=self.force,
                         end_distance=self.end_distance)

@@ -242,6 +242,10 @@ def default_coarse_nodes(nodes: int) -> int | None:
     (:data:`REFINE_FROM` above 1.5 times that many, else None: no mesh continuation)."""
     return REFINE_FROM if 2 * nodes > 3 * REFINE_FROM else None
 
+#: How a sectioned scene's load path runs (:func:`tightknot.loading.tie.path_scene`).
+SECTION_PATHS = ("final", "full")
+
+
 @dataclass(frozen=True)
 class LoadPath:
     """The load path that ties a knot (SI units): tighten (the rest length shrinks to L0),
@@ -276,6 +280,11 @@ class LoadPath:
                                      "(tightknot.loading.refine)",
                                      default_text=f"{REFINE_FROM} for a rod of more than "
                                      f"{3 * REFINE_FROM // 2} vertices, else off", metavar="N")
+    section_path: str = param("final", SECTION_PATHS, "",
+                              "the sectioned level's load path: final (relax, tighten and "
+                              "pull at the compliant level, the sections' equilibrium solved "
+                              "under the final load; an open knot's target Lambda_OC sought "
+                              "again there) or full (every load step with the sections)")
 
 
 #: The loads of an open knot's pull: a run gives exactly one of them.

@@ -18,7 +18,15 @@ from tightknot.loading.diagnose import topology_change
 from tightknot.loading.levels import Check, LevelLoad, LevelOptions, LevelPath, SearchOptions
 from tightknot.loading.options import LoadPath
 from tightknot.loading.recentre import recentre_system
-from tightknot.loading.tie import StepHook, TieResult, end_reaction, knot_type_of, tie
+from tightknot.loading.tie import (
+    StepHook,
+    TieResult,
+    end_reaction,
+    knot_type_of,
+    path_scene,
+    section_finish,
+    tie,
+)
 from tightknot.solvers.continuation import StepRecord
 from tightknot.solvers.newton import NewtonOptions
 from tightknot.solvers.program import Coroutine, Program
@@ -82,6 +90,7 @@ def tie_to_lambda(
     max_force_steps: int = 60,
     residual_tol: float = LoadPath.residual_tol,
     hook: StepHook | None = None,
+    section_path: str = LoadPath.section_path,
 ) -> Program[TieResult]:
     """Tie an open knot, then pull until Lambda_OC = ``target`` within ``tolerance``; a
     program (:mod:`tightknot.solvers.program`): ``.run()`` returns the
@@ -94,6 +103,11 @@ def tie_to_lambda(
     in log force once the target is bracketed (:meth:`tightknot.loading.levels.LevelPath.
     seek`). Each force is a static Newton solve from the last equilibrium (proximal steps
     where it fails).
+
+    A sectioned scene with ``section_path`` "final" (:func:`tightknot.loading.tie.
+    path_scene`) runs all this at the compliant level, then solves the sections'
+    equilibrium at the force found there and searches the force again from it: the
+    sections change the knot length a force gives.
     """
     if scene.closed:
         raise ValueError("tie_to_lambda is for open knots")
@@ -101,15 +115,32 @@ def tie_to_lambda(
         raise ValueError(f"target Lambda_OC must be finite and > 0, got {target!r}")
     search = SearchOptions(tolerance=tolerance, step_ratio=force_ratio,
                            max_steps=max_force_steps, retries=3, refine="bisection")
-    return Program(_tie_to_lambda(scene, target, search, residual_tol, hook), "tie_to_lambda")
+    via = path_scene(scene, section_path)
+    return Program(_tie_to_lambda(scene, via, target, search, residual_tol, hook),
+                   "tie_to_lambda")
 
 
-def _tie_to_lambda(scene: KnotScene, target: float, search: SearchOptions,
+def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: SearchOptions,
                    residual_tol: float, hook: StepHook | None) -> Coroutine[TieResult]:
-    """The coroutine of :func:`tie_to_lambda` (its arguments checked)."""
-    res = yield from tie(scene, tighten_steps=40, residual_tol=residual_tol, hook=hook)
+    """The coroutine of :func:`tie_to_lambda` (its arguments checked; the load path on
+    ``via``, :func:`tightknot.loading.tie.path_scene`)."""
+    res = yield from tie(via, tighten_steps=40, residual_tol=residual_tol, hook=hook,
+                         section_path="full")
     if not res.converged:
         return res
+    res = yield from _seek(via, res, target, search, residual_tol, hook)
+    if via is scene or not res.converged:
+        return res
+    res = yield from section_finish(scene, res, residual_tol, hook)
+    if not res.converged:
+        return res
+    return (yield from _seek(scene, res, target, search, residual_tol, hook))
+
+
+def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions,
+          residual_tol: float, hook: StepHook | None) -> Coroutine[TieResult]:
+    """From ``res`` (an open knot of ``scene`` in equilibrium), the pull whose Lambda_OC is
+    ``target``: the force the end carries now, then searched (``search``)."""
     start = time.perf_counter()
     types = list(res.knot_types)
     # Every force is one static solve: the search itself retries a failed step.

@@ -20,6 +20,7 @@ a converged solve; a slide is followed by one.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -27,15 +28,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tightknot.contact.sectioned import SectionedLayer
 from tightknot.knots import topology
 from tightknot.knots.scenes import (
     KnotScene,
     bending_force_scale,
+    contact_layer,
     end_vertex,
     gauge,
 )
 from tightknot.loading.diagnose import topology_change
-from tightknot.loading.options import LoadPath
+from tightknot.loading.options import SECTION_PATHS, LoadPath
 from tightknot.loading.recentre import recentre_system
 from tightknot.rods.state import State
 from tightknot.solvers.continuation import (
@@ -44,6 +47,7 @@ from tightknot.solvers.continuation import (
     StepRecord,
     continuation,
 )
+from tightknot.solvers.dynamic import proximal
 from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.program import Coroutine, Program
 from tightknot.solvers.system import RodSystem
@@ -138,6 +142,7 @@ def tie(
     attach: Callable[[RodSystem], None] | None = None,
     start_state: State | None = None,
     knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
+    section_path: str = LoadPath.section_path,
 ) -> Program[TieResult]:
     """Tie ``scene``: shrink its rest length to L0, then (open knots) pull. A program
     (:mod:`tightknot.solvers.program`): ``tie(scene).run()`` returns the
@@ -155,6 +160,9 @@ def tie(
             it, :class:`tightknot.solvers.lockstep.BatchRod`).
         start_state: where to start (default: the scene's state).
         knot_type: the knot type of a centerline (default :func:`knot_type_of`).
+        section_path: a sectioned scene's load path (:func:`path_scene`): "final" runs it
+            at the compliant level and solves the sections' equilibrium under its last
+            load (:func:`section_finish`); "full" runs every step with the sections.
     """
     if scene.contact is None:
         raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
@@ -167,9 +175,100 @@ def tie(
         raise ValueError(f"pull_force must be finite and > 0 N, got {pull_force!r}")
     if end_distance is not None and not (math.isfinite(end_distance) and end_distance > 0):
         raise ValueError(f"end_distance must be finite and > 0 m, got {end_distance!r}")
-    return Program(_tie(scene, pull_force, end_distance, tighten_steps, pull_steps,
-                        residual_tol, hold_force_scale, relax_iterations, hook, attach,
-                        start_state, knot_type), "tie")
+    via = path_scene(scene, section_path)
+    if via is not scene and attach is not None:
+        raise ValueError(f"{scene.name}: contact='sectioned' is tied one rod at a time (a "
+                         "batch's banded systems hold no section dofs)")
+    body = _tie(via, pull_force, end_distance, tighten_steps, pull_steps, residual_tol,
+                hold_force_scale, relax_iterations, hook, attach, start_state, knot_type)
+    if via is not scene:
+        body = _then_sections(scene, body, end_distance is not None, residual_tol, hook,
+                              knot_type)
+    return Program(body, "tie")
+
+
+def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> KnotScene:
+    """The scene a load path of ``scene`` runs on: ``scene`` itself, but for a sectioned
+    scene with ``section_path`` "final" the same rod and start at the compliant level.
+
+    The sections matter where the knot is tight; on the way there (the start's relaxation,
+    the tightening, a pull's search) the compliant level keeps the same centerline
+    guarantees (the step bound and the proximity check act on the centerlines at both
+    levels) at a tenth of the cost per Newton iteration, and a frictionless knot's
+    equilibrium under the final load does not depend on the path that led to it
+    (docs/sectioned_level.md measures both paths)."""
+    if section_path not in SECTION_PATHS:
+        raise ValueError(f"section_path must be one of {', '.join(SECTION_PATHS)}, got "
+                         f"{section_path!r}")
+    if section_path == "full" or not isinstance(scene.contact, SectionedLayer):
+        return scene
+    return dataclasses.replace(scene, contact=contact_layer(scene.model, "compliant"),
+                               rebuild=None)
+
+
+def _then_sections(scene: KnotScene, path: Coroutine[TieResult], end_held: bool,
+                   residual_tol: float, hook: StepHook | None,
+                   knot_type: Callable[[KnotScene, np.ndarray], str]) -> Coroutine[TieResult]:
+    """The load path ``path`` (on :func:`path_scene`), then the sections' equilibrium."""
+    res = yield from path
+    if not res.converged:
+        return dataclasses.replace(res, failure=f"{res.failure} (on the way, at the "
+                                   "compliant level: section_path final)")
+    return (yield from section_finish(scene, res, residual_tol, hook, knot_type, end_held))
+
+
+def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
+                   hook: StepHook | None = None,
+                   knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
+                   end_held: bool = False) -> Coroutine[TieResult]:
+    """The equilibrium of ``scene`` at its own contact level under the last load of
+    ``res``, a converged load path of the same rod at another level (:func:`path_scene`):
+    one static solve from its equilibrium, round sections added (proximal steps where
+    Newton fails), the knot type checked, ``hook("section", ...)`` called with it. With
+    ``end_held`` the pulling force is the held end's reaction at the new equilibrium.
+    On failure the result's state is the load path's equilibrium (round sections), the
+    failed solve's end in ``failed_state``."""
+    t0 = time.perf_counter()
+    done = res.system
+    system = RodSystem(scene.model, done.state.copy(), done.bcs)
+    system.add_term(scene.contact)
+    system.history = []
+    system.set_load(done.t)
+    start = system.state.copy()
+    # The sections start round at a tight knot's contacts: a longer way than a load
+    # step's, hence a relaxation's budget.
+    opts = NewtonOptions(residual_tol=residual_tol, max_iterations=400)
+    r = yield from newton(system, system.free_vector(), opts)
+    iters = r.iterations
+    why = "" if r.converged else f"Newton {r.reason}"
+    if why:
+        steps = load_step_options(1, residual_tol)
+        prox = yield from proximal(system, steps.proximal_dt, steps.proximal_steps,
+                                   steps.newton)
+        iters += prox.newton_iterations
+        why = "" if prox.converged else f"{why}, then proximal steps {prox.reason}"
+    types = list(res.knot_types)
+    rec = StepRecord(done.t, r)
+    if not why:
+        kt = knot_type(scene, system.state.x)
+        types.append(kt)
+        if kt != scene.knot_type:
+            why = (f"knot type {kt}, expected {scene.knot_type}: "
+                   f"{topology_change(scene, system.history or [], system.rest, knot_type)}")
+    failed = None
+    if why:
+        failed = system.state.copy()
+        system.state = start
+    elif hook is not None:
+        hook("section", system, rec)
+    wall = time.perf_counter() - t0
+    phases = dict(res.phases)
+    phases["section"] = StaticResult(not why, done.t if not why else 0.0,
+                                     [] if why else [rec], iters, why, wall, failed)
+    force = end_reaction(system) if end_held and not why else res.pull_force_N
+    return TieResult(not why, f"section: {why}" if why else "", phases,
+                     res.newton_iterations + iters, res.wall_time_s + wall, types, force,
+                     system, failed)
 
 
 def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from tightknot.contact.checks import deepest_approaches
+from tightknot.contact.layer import ContactLayer
 from tightknot.contact.report import ContactReport, contact_report
 from tightknot.contact.sectioned import SectionedLayer
 from tightknot.knots.curvature import bergou_curvature
@@ -80,6 +81,13 @@ def check_color_field(name: str) -> str:
     return name
 
 
+def system_contact(system: RodSystem, scene: KnotScene) -> ContactLayer:
+    """The contact layer ``system`` is solved with: a sectioned scene's load path runs at
+    the compliant level (:func:`tightknot.loading.tie.path_scene`), and its steps are
+    reported at that level."""
+    return next((t for t in system.extra_terms if isinstance(t, ContactLayer)), scene.contact)
+
+
 def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
               color_by: str = "kappa_D0", phase: str | None = None) -> None:
     """Log the rod (tube coloured by ``color_by``, deformed radii) and its contact pairs
@@ -89,7 +97,7 @@ def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
     the tightening's end reaction and the pull's force are separate series."""
     x = system.state.x
     r_e, r_v = vertex_radii(scene, x, system.rest)
-    rep = contact_report(scene.contact, x, system.rest, system.state)
+    rep = contact_report(system_contact(system, scene), x, system.rest, system.state)
     values, at = rod_field(color_by, scene, x, system.rest, rep)
     log.log_rod(f"{name}/rod", x, scene.closed, r_e, values, color_by, field_at=at,
                 radii_at="edge")

@@ -47,10 +47,11 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
 #: coarse count that its vertex count implies (``default_coarse_nodes``), and writes no
 #: pictures; the device is the sweep's, not the case's; it sweeps the built-in knots from
 #: their parametric starts, not a user's start curve or an ideal start (``tie --start``,
-#: ``--start-shape``).
+#: ``--start-shape``); a sectioned case runs tie()'s default path to its equilibrium
+#: (``section_path`` "final"), which that path does not change.
 NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
                  "coarse_nodes", "color_by", "device", "start", "units", "columns",
-                 "start_shape")
+                 "start_shape", "section_path")
 #: Level lists of an open knot -> the load each level is (its range and unit).
 LEVELS = {"pull_force": "force", "target_lambda": "target_lambda"}
 LEVEL_KEYS = tuple(LEVELS)
