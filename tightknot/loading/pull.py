@@ -134,13 +134,17 @@ def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: Sear
     res = yield from section_finish(scene, res, residual_tol, hook)
     if not res.converged:
         return res
-    return (yield from _seek(scene, res, target, search, residual_tol, hook))
+    # (the sections' equilibrium is one under the pull already: no first solve)
+    return (yield from _seek(scene, res, target, search, residual_tol, hook, pulled=True))
 
 
 def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions,
-          residual_tol: float, hook: StepHook | None) -> Coroutine[TieResult]:
+          residual_tol: float, hook: StepHook | None, pulled: bool = False
+          ) -> Coroutine[TieResult]:
     """From ``res`` (an open knot of ``scene`` in equilibrium), the pull whose Lambda_OC is
-    ``target``: the force the end carries now, then searched (``search``)."""
+    ``target``: first the equilibrium under the force the end carries now, centred on its
+    rod (unless ``pulled``: ``res`` is one under that dead force already), then the force
+    searched (``search``)."""
     start = time.perf_counter()
     types = list(res.knot_types)
     # Every force is one static solve: the search itself retries a failed step.
@@ -154,8 +158,9 @@ def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions
                          res.wall_time_s + time.perf_counter() - start, types, path.level,
                          path.system)
 
-    why = yield from path.solve(path.level)
-    if why:
-        return done(why)
+    if not pulled:
+        why = yield from path.solve(path.level)
+        if why:
+            return done(why)
     why = yield from path.seek(target, lambda s: knot_length(scene, s), search)
     return done(why)
