@@ -3,7 +3,7 @@
 ratios, not seconds: the machines are shared).
 
 Usage: ``python bench/contact_levels.py [--closed-nodes 100] [--open-nodes 150]
-[--levels compliant smoothed] [--json out.json]``.
+[--levels compliant smoothed] [--section-path auto] [--json out.json]``.
 """
 
 from __future__ import annotations
@@ -24,29 +24,33 @@ from tightknot.loading.tie import tie
 OPEN_CASES = (("open_125mm_to_10.1", 0.125, 10.1), ("open_185mm_to_15", 0.185, 15.0))
 
 
-def closed_case(level: str, nodes: int) -> dict:
-    """The closed trefoil at L0/D0 = 16.37."""
+def closed_case(level: str, nodes: int, section_path: str = "auto") -> dict:
+    """The closed trefoil at L0/D0 = 16.37 (``section_path``: the sectioned level's load
+    path, :func:`tightknot.loading.tie.path_scene`)."""
     scene = closed_trefoil(16.37, nodes=nodes, contact=level)
     t0 = time.perf_counter()
-    res = tie(scene, tighten_steps=20).run()
+    res = tie(scene, tighten_steps=20, section_path=section_path).run()
     wall = time.perf_counter() - t0
     x = res.system.state.x
     length = float(np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1).sum())
     return {"case": "closed_16.37", "level": level, "vertices": nodes,
+            "section_path": section_path,
             "converged": res.converged, "failure": res.failure,
             "knot_types": sorted(set(res.knot_types)), "newton_iterations": res.newton_iterations,
             "wall_time_s": wall, "stretch": length / scene.rest_length}
 
 
-def open_case(level: str, nodes: int, name: str, length: float, target: float) -> dict:
+def open_case(level: str, nodes: int, name: str, length: float, target: float,
+              section_path: str = "auto") -> dict:
     """An open trefoil of rest ``length`` [m] pulled to Lambda_OC ``target``."""
     scene = open_trefoil(length, nodes=nodes, contact=level)
     t0 = time.perf_counter()
-    res = tie_to_lambda(scene, target).run()
+    res = tie_to_lambda(scene, target, section_path=section_path).run()
     wall = time.perf_counter() - t0
     x = res.system.state.x
     lam = lambda_oc(x, scene.diameter, vertex_radii(scene, x, res.system.rest)[1])
-    return {"case": name, "level": level, "vertices": nodes, "converged": res.converged,
+    return {"case": name, "level": level, "vertices": nodes, "section_path": section_path,
+            "converged": res.converged,
             "failure": res.failure, "knot_types": sorted(set(res.knot_types)),
             "newton_iterations": res.newton_iterations, "wall_time_s": wall,
             "lambda_oc": lam, "pull_force_N": res.pull_force_N}
@@ -58,15 +62,18 @@ def main() -> None:
     parser.add_argument("--open-nodes", type=int, default=150)
     parser.add_argument("--levels", nargs="+", default=["compliant", "smoothed"],
                         choices=["compliant", "smoothed", "sectioned", "rigid"])
+    parser.add_argument("--section-path", default="auto", choices=["auto", "final", "full"],
+                        help="the sectioned level's load path (tightknot.loading.tie.path_scene)")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     tie(closed_trefoil(nodes=40), tighten_steps=5).run()  # compile the kernels outside the timing
     rows = []
     for level in args.levels:
-        rows.append(closed_case(level, args.closed_nodes))
+        rows.append(closed_case(level, args.closed_nodes, args.section_path))
         print(json.dumps(rows[-1]))
         for name, length, target in OPEN_CASES:
-            rows.append(open_case(level, args.open_nodes, name, length, target))
+            rows.append(open_case(level, args.open_nodes, name, length, target,
+                                  args.section_path))
             print(json.dumps(rows[-1]))
     base = {r["case"]: r for r in rows if r["level"] == args.levels[0]}
     ratios = [{"case": r["case"], "level": r["level"],

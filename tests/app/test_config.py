@@ -102,11 +102,11 @@ def test_every_color_field_is_computed() -> None:
 def test_tie_options() -> None:
     closed = config_from_dict({"knot": "closed", "relax_iterations": 7})
     assert closed.tie_options() == {"tighten_steps": 40, "residual_tol": 1e-6,
-                                    "relax_iterations": 7, "section_path": "final"}
+                                    "relax_iterations": 7, "section_path": "auto"}
     pulled = config_from_dict({"knot": "open", "end_distance": 0.1})
     assert pulled.tie_options()["end_distance"] == 0.1
     assert pulled.tie_options()["pull_force"] is None
     lam = config_from_dict({"knot": "open", "target_lambda": 12.0})
     assert lam.tie_options() == {"target_lambda": 12.0, "tolerance": 0.1, "residual_tol": 1e-6,
-                                 "section_path": "final"}
+                                 "section_path": "auto"}
     assert isinstance(lam, TieConfig) and lam.scene_name == "open_trefoil"

@@ -123,8 +123,7 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
             arr(np.arange(16), wp.int32)]
     bsz = 3 + K
     outs = [wp.zeros(2, dtype=f), wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),
-            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(2 * nl * nl, dtype=f),
-            wp.zeros(1, dtype=f), wp.zeros(1, dtype=f)]
+            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f)]
     wp.launch(sk.DERIVATIVES, 2, model + data, outs)
     g = outs[2].numpy().reshape(2, nl)
     grad = g[0].copy()

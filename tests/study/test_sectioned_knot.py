@@ -11,7 +11,7 @@ from tightknot.contact.sectioned import SectionedLayer, SectionSettings
 from tightknot.knots.scenes import closed_trefoil, open_trefoil
 from tightknot.loading.batch import tie_batch
 from tightknot.loading.pull import knot_length, tie_to_lambda
-from tightknot.loading.tie import tie
+from tightknot.loading.tie import path_scene, tie
 from tightknot.study.run import run_knot
 
 
@@ -99,8 +99,8 @@ def test_an_open_knot_is_sought_again_at_the_sectioned_level() -> None:
     then 11.99)."""
     scene = open_trefoil(0.125, nodes=100, contact="sectioned")
     calls: list[tuple[str, int]] = []
-    res = tie_to_lambda(scene, 12.0, hook=lambda phase, system, rec: calls.append(
-        (phase, system.state.extra.size))).run()
+    res = tie_to_lambda(scene, 12.0, section_path="final", hook=lambda phase, system, rec:
+                        calls.append((phase, system.state.extra.size))).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     assert knot_length(scene, res.system) == pytest.approx(12.0, abs=0.1)
@@ -114,5 +114,19 @@ def test_an_open_knot_is_sought_again_at_the_sectioned_level() -> None:
 
 def test_a_bad_section_path_is_refused() -> None:
     scene = closed_trefoil(16.37, nodes=60, contact="sectioned")
-    with pytest.raises(ValueError, match="section_path must be one of final, full"):
+    with pytest.raises(ValueError, match="section_path must be one of auto, final, full"):
         tie(scene, section_path="half")
+
+
+def test_auto_pulls_an_open_knot_with_its_sections() -> None:
+    """section_path "auto" (the default): a closed knot's load path runs at the compliant
+    level, an open knot is pulled with its sections (a pulled knot can have two
+    equilibria, and the way there picks one: docs/sectioned_level.md)."""
+    closed = closed_trefoil(16.37, nodes=60, contact="sectioned")
+    opened = open_trefoil(0.125, nodes=100, contact="sectioned")
+    via = path_scene(closed)
+    assert via is not closed and not isinstance(via.contact, SectionedLayer)
+    assert via.model is closed.model
+    assert path_scene(opened) is opened
+    assert path_scene(opened, "final") is not opened
+    assert path_scene(closed, "full") is closed

@@ -416,13 +416,12 @@ class SectionedLayer(ContactLayer):
         blocks = wp.zeros(block_count * b * b if derivatives else 1, dtype=f64, device=dev)
         w_slots = wp.array(slots.astype(np.int32).ravel() if derivatives else np.zeros(1, np.int32),
                            dtype=wp.int32, device=dev)
-        local = wp.zeros(threads * nl * nl if derivatives else 1, dtype=f64, device=dev)
         ns = threads * ng * self.section.samples if report else 1
         s_pen = wp.zeros(ns, dtype=f64, device=dev)
         s_wt = wp.zeros(ns, dtype=f64, device=dev)
         wp.launch(kernel, threads, [*self._model_args, wx, *data,
                                     self.broad_phase.buffer_of(pairs), w_slots],
-                  [energy, pen_max, grad, blocks, local, s_pen, s_wt], device=dev)
+                  [energy, pen_max, grad, blocks, s_pen, s_wt], device=dev)
         out = {"energy": energy.numpy(), "pen_max": pen_max.numpy()}
         if derivatives:
             out["grad"] = grad.numpy().reshape(threads, nl)

@@ -15,8 +15,11 @@ Per sample, every derivative over the L dofs is a combination of 16 reduced dire
 12 vertex coordinates and, for the sections, A's boundary at the sample's angle (along
 B(phi) + dR/dc, carried to A's two vertices by the interpolation weights), B's boundary at
 the angle psi facing the sample, its slope in psi, and the derivative of B's interpolation
-weights in the projection v. The per-sample Hessian is formed in those 16 directions and
-then expanded.
+weights in the projection v. The per-sample Hessian is formed in those 16 directions,
+carried to the pass's dofs and summed over the pass's samples in registers, one block per
+pair of its nodes (the coordinates' 12 x 12, the coordinates against each vertex's
+coefficients, the coefficients' K x K blocks), which are added into the node-pair blocks
+once per pass.
 
 Work is skipped where no contact can be: a Gauss circle of A whose axis point is farther
 from B's axis than the two sections' largest radii, and a sample farther from B's axis
@@ -42,6 +45,9 @@ vec6d = wp.types.vector(length=6, dtype=wp.float64)
 mat66d = wp.types.matrix(shape=(6, 6), dtype=wp.float64)
 mat36d = wp.types.matrix(shape=(3, 6), dtype=wp.float64)
 mat6x16d = wp.types.matrix(shape=(6, 16), dtype=wp.float64)
+mat12d = wp.types.matrix(shape=(12, 12), dtype=wp.float64)
+mat12xKd = wp.types.matrix(shape=(12, MAX_COEFF), dtype=wp.float64)
+matKd = wp.types.matrix(shape=(MAX_COEFF, MAX_COEFF), dtype=wp.float64)
 
 wp.set_module_options({"max_unroll": 1, "enable_backward": False})
 
@@ -468,7 +474,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         pen_max_out: wp.array(dtype=wp.float64),
         grad_out: wp.array(dtype=wp.float64),
         blocks_out: wp.array(dtype=wp.float64),
-        local_out: wp.array(dtype=wp.float64),
         sample_pen_out: wp.array(dtype=wp.float64),
         sample_weight_out: wp.array(dtype=wp.float64),
     ):
@@ -556,6 +561,26 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         mtb = end_twist_in[eb]
         go = tid * nl
         touched = int(0)
+        if wp.static(derivatives):
+            # The pass's Hessian over (x_A0, x_A1, x_B0, x_B1, c_A0, c_A1, c_B0, c_B1),
+            # summed over its samples in registers: the coordinates' block, the
+            # coordinates against each vertex's coefficients, and the coefficients' blocks
+            # of the node pairs (the diagonal ones upper triangles only).
+            h_xx = mat12d()
+            h_xa0 = mat12xKd()
+            h_xa1 = mat12xKd()
+            h_xb0 = mat12xKd()
+            h_xb1 = mat12xKd()
+            h_a0a0 = matKd()
+            h_a0a1 = matKd()
+            h_a1a1 = matKd()
+            h_a0b0 = matKd()
+            h_a0b1 = matKd()
+            h_a1b0 = matKd()
+            h_a1b1 = matKd()
+            h_b0b0 = matKd()
+            h_b0b1 = matKd()
+            h_b1b1 = matKd()
         for gi in range(ng):
             u = gauss_xi[gi]
             xu = xa0 + u * vec_a
@@ -698,12 +723,123 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     h -= (ph[1] * wt1) * (wp.outer(r_g, r_v) + wp.outer(r_v, r_g))
                     h += ph[0] * (wt2 * wp.outer(r_v, r_v) + wt1 * hvr)
                     h = a_s * h
-                    expand(h, r_grad, u, v, ba, bb, bpsi1, mta, mtb, k, go, tid * nl * nl,
-                           nl, rig_a, rig_b, grad_out, local_out)
+                    # The sample's gradient and Hessian carried from the 16 reduced
+                    # directions to the pass's dofs (the section directions: alpha by
+                    # (1 - u) and u Q to A's vertices, beta and gamma by (1 - v) and v Q,
+                    # delta by -1 and Q to B's), added to the registers above.
+                    qa = rotate_modes(ba, mta, k, 0)
+                    qb = rotate_modes(bb, mtb, k, 0)
+                    qs = rotate_modes(bpsi1, mtb, k, 0)
+                    one_u = f64(1.0) - u
+                    one_v = f64(1.0) - v
+                    wa0 = one_u * ba
+                    wa1 = u * qa
+                    x0 = one_v * bb
+                    y0 = one_v * bpsi1
+                    x1 = v * qb
+                    y1 = v * qs
+                    for i in range(12):
+                        grad_out[go + i] = grad_out[go + i] + r_grad[i]
+                        for j in range(12):
+                            if j >= i:
+                                h_xx[i, j] = h_xx[i, j] + h[i, j]
+                            else:
+                                h_xx[i, j] = h_xx[i, j] + h[j, i]
+                    if rig_a == 0:
+                        for j in range(k):
+                            grad_out[go + 12 + j] = grad_out[go + 12 + j] + r_grad[12] * wa0[j]
+                            grad_out[go + 12 + k + j] = (grad_out[go + 12 + k + j]
+                                                         + r_grad[12] * wa1[j])
+                        for i in range(12):
+                            cxa = h[i, 12]
+                            for j in range(k):
+                                h_xa0[i, j] = h_xa0[i, j] + cxa * wa0[j]
+                                h_xa1[i, j] = h_xa1[i, j] + cxa * wa1[j]
+                        caa = h[12, 12]
+                        for i in range(k):
+                            for j in range(k):
+                                h_a0a1[i, j] = h_a0a1[i, j] + caa * wa0[i] * wa1[j]
+                                if j >= i:
+                                    h_a0a0[i, j] = h_a0a0[i, j] + caa * wa0[i] * wa0[j]
+                                    h_a1a1[i, j] = h_a1a1[i, j] + caa * wa1[i] * wa1[j]
+                    if rig_b == 0:
+                        for j in range(k):
+                            grad_out[go + 12 + 2 * k + j] = (grad_out[go + 12 + 2 * k + j]
+                                                             + r_grad[13] * x0[j])
+                            grad_out[go + 12 + 3 * k + j] = (grad_out[go + 12 + 3 * k + j]
+                                                             + r_grad[13] * x1[j])
+                        for i in range(12):
+                            hb_i = h[i, 13]
+                            hg_i = h[i, 14]
+                            hd_i = h[i, 15]
+                            for j in range(k):
+                                h_xb0[i, j] = (h_xb0[i, j] + hb_i * x0[j] + hg_i * y0[j]
+                                               - hd_i * bb[j])
+                                h_xb1[i, j] = (h_xb1[i, j] + hb_i * x1[j] + hg_i * y1[j]
+                                               + hd_i * qb[j])
+                        for i in range(k):
+                            # B's rows in (beta, gamma, delta), times h_BB
+                            p0 = h[13, 13] * x0[i] + h[14, 13] * y0[i] - h[15, 13] * bb[i]
+                            q0 = h[13, 14] * x0[i] + h[14, 14] * y0[i] - h[15, 14] * bb[i]
+                            s0 = h[13, 15] * x0[i] + h[14, 15] * y0[i] - h[15, 15] * bb[i]
+                            p1 = h[13, 13] * x1[i] + h[14, 13] * y1[i] + h[15, 13] * qb[i]
+                            q1 = h[13, 14] * x1[i] + h[14, 14] * y1[i] + h[15, 14] * qb[i]
+                            s1 = h[13, 15] * x1[i] + h[14, 15] * y1[i] + h[15, 15] * qb[i]
+                            for j in range(k):
+                                h_b0b1[i, j] = h_b0b1[i, j] + p0 * x1[j] + q0 * y1[j] + s0 * qb[j]
+                                if j >= i:
+                                    h_b0b0[i, j] = (h_b0b0[i, j] + p0 * x0[j] + q0 * y0[j]
+                                                    - s0 * bb[j])
+                                    h_b1b1[i, j] = (h_b1b1[i, j] + p1 * x1[j] + q1 * y1[j]
+                                                    + s1 * qb[j])
+                        if rig_a == 0:
+                            rb = h[12, 13]
+                            rg = h[12, 14]
+                            rd = h[12, 15]
+                            t0 = rb * x0 + rg * y0 - rd * bb
+                            t1 = rb * x1 + rg * y1 + rd * qb
+                            for i in range(k):
+                                for j in range(k):
+                                    h_a0b0[i, j] = h_a0b0[i, j] + wa0[i] * t0[j]
+                                    h_a0b1[i, j] = h_a0b1[i, j] + wa0[i] * t1[j]
+                                    h_a1b0[i, j] = h_a1b0[i, j] + wa1[i] * t0[j]
+                                    h_a1b1[i, j] = h_a1b1[i, j] + wa1[i] * t1[j]
                     touched = 1
         if wp.static(derivatives):
             if touched != 0:
-                scatter_blocks(local_out, tid * nl * nl, nl, k, tid, slots_in, blocks_out)
+                pair = tid // 2
+                flip = tid % 2
+                bsz = 3 + k
+                for n in range(4):
+                    for m in range(4):
+                        nn = n
+                        mm = m
+                        if flip == 1:
+                            nn = (n + 2) % 4
+                            mm = (m + 2) % 4
+                        base = slots_in[pair * 16 + nn * 4 + mm] * bsz * bsz
+                        for r in range(3):
+                            for c in range(3):
+                                wp.atomic_add(blocks_out, base + r * bsz + c,
+                                              h_xx[3 * n + r, 3 * m + c])
+                # coordinates against coefficients (and their transposes)
+                if rig_a == 0:
+                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, h_xa0)
+                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, h_xa1)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 0, h_a0a0, 1)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 1, h_a1a1, 1)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 1, h_a0a1, 0)
+                if rig_b == 0:
+                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 2, h_xb0)
+                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 3, h_xb1)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 2, 2, h_b0b0, 1)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 3, 3, h_b1b1, 1)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 2, 3, h_b0b1, 0)
+                if rig_a == 0 and rig_b == 0:
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 2, h_a0b0, 0)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 3, h_a0b1, 0)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 2, h_a1b0, 0)
+                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 3, h_a1b1, 0)
         energy_out[tid] = energy
         pen_max_out[tid] = pen_max
 
@@ -712,143 +848,56 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
 
 
 @wp.func
-def add_sym(buf: wp.array(dtype=wp.float64), base: int, nl: int, i: int, j: int,
-            val: wp.float64):
-    """Add ``val`` at (i, j) and (j, i) of the pass's local Hessian (once on the diagonal)."""
-    buf[base + i * nl + j] = buf[base + i * nl + j] + val
-    if i != j:
-        buf[base + j * nl + i] = buf[base + j * nl + i] + val
+def _slot_base(slots: wp.array(dtype=wp.int32), pair: int, flip: int, n: int, m: int,
+               bsz: int) -> int:
+    """Offset of the node-pair block (pass nodes n, m: A0, A1, B0, B1) in the blocks: pair
+    p's 16 blocks are ``slots[16 p + 4 n + m]`` in its (a0, a1, b0, b1) order, and pass 1
+    has A = b (its node n is the pair's (n + 2) % 4)."""
+    nn = n
+    mm = m
+    if flip == 1:
+        nn = (n + 2) % 4
+        mm = (m + 2) % 4
+    return slots[pair * 16 + nn * 4 + mm] * bsz * bsz
 
 
 @wp.func
-def expand(h: mat16d, r_grad: vec16d, u: wp.float64, v: wp.float64, ba: vecKd, bb: vecKd,
-           bs: vecKd, mta: wp.float64, mtb: wp.float64, k: int, go: int, base: int, nl: int,
-           rig_a: int, rig_b: int, grad_out: wp.array(dtype=wp.float64),
-           local: wp.array(dtype=wp.float64)):
-    """Add a sample's reduced gradient and Hessian to the pass's local ones (over x_A0,
-    x_A1, x_B0, x_B1, then the sections of A0, A1, B0, B1: k each). The section directions
-    are carried to the vertices: alpha (``ba``) by (1 - u) and u Q to A's, beta (``bb``)
-    and gamma (``bs``) by (1 - v) and v Q to B's, delta (``bb``) by -1 and Q to B's; each
-    block is formed in that low-rank form (a rank-1 block for A's sections, rank 3 for
-    B's), not by the dense expansion."""
-    qa = rotate_modes(ba, mta, k, 0)
-    qb = rotate_modes(bb, mtb, k, 0)
-    qs = rotate_modes(bs, mtb, k, 0)
-    one_u = f64(1.0) - u
-    one_v = f64(1.0) - v
-    a0 = 12
-    a1 = 12 + k
-    b0 = 12 + 2 * k
-    b1 = 12 + 3 * k
-    for i in range(12):
-        grad_out[go + i] = grad_out[go + i] + r_grad[i]
-        for j in range(i, 12):
-            add_sym(local, base, nl, i, j, h[i, j])
-    for j in range(k):
-        if rig_a == 0:
-            grad_out[go + a0 + j] = grad_out[go + a0 + j] + r_grad[12] * one_u * ba[j]
-            grad_out[go + a1 + j] = grad_out[go + a1 + j] + r_grad[12] * u * qa[j]
-        if rig_b == 0:
-            grad_out[go + b0 + j] = grad_out[go + b0 + j] + r_grad[13] * one_v * bb[j]
-            grad_out[go + b1 + j] = grad_out[go + b1 + j] + r_grad[13] * v * qb[j]
-    # B's section weights on (beta, gamma, delta) at its two vertices
-    for i in range(12):
-        if rig_a == 0:
-            c = h[i, 12]
+def scatter_x_coeff(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp.int32),
+                    pair: int, flip: int, bsz: int, k: int, m: int, hx: mat12xKd):
+    """Add the coordinates' rows against node m's coefficients (``hx``, 12 x k) into the
+    node-pair blocks (n, m), and their transposes into (m, n), for the four nodes n."""
+    for n in range(4):
+        base = _slot_base(slots, pair, flip, n, m, bsz)
+        base_t = _slot_base(slots, pair, flip, m, n, bsz)
+        for r in range(3):
             for j in range(k):
-                add_sym(local, base, nl, i, a0 + j, c * one_u * ba[j])
-                add_sym(local, base, nl, i, a1 + j, c * u * qa[j])
-        if rig_b == 0:
-            cb = h[i, 13]
-            cg = h[i, 14]
-            cd = h[i, 15]
-            for j in range(k):
-                add_sym(local, base, nl, i, b0 + j,
-                        one_v * (cb * bb[j] + cg * bs[j]) - cd * bb[j])
-                add_sym(local, base, nl, i, b1 + j, v * (cb * qb[j] + cg * qs[j]) + cd * qb[j])
-    if rig_a == 0:
-        caa = h[12, 12]
-        for i in range(k):
-            wi0 = one_u * ba[i]
-            wi1 = u * qa[i]
-            for j in range(k):
-                w0 = one_u * ba[j]
-                w1 = u * qa[j]
-                if j >= i:
-                    add_sym(local, base, nl, a0 + i, a0 + j, caa * wi0 * w0)
-                    add_sym(local, base, nl, a1 + i, a1 + j, caa * wi1 * w1)
-                add_sym(local, base, nl, a0 + i, a1 + j, caa * wi0 * w1)
-            if rig_b == 0:
-                # A's alpha row against B's (beta, gamma, delta)
-                rb = h[12, 13]
-                rg = h[12, 14]
-                rd = h[12, 15]
-                for j in range(k):
-                    t0 = one_v * (rb * bb[j] + rg * bs[j]) - rd * bb[j]
-                    t1 = v * (rb * qb[j] + rg * qs[j]) + rd * qb[j]
-                    add_sym(local, base, nl, a0 + i, b0 + j, wi0 * t0)
-                    add_sym(local, base, nl, a0 + i, b1 + j, wi0 * t1)
-                    add_sym(local, base, nl, a1 + i, b0 + j, wi1 * t0)
-                    add_sym(local, base, nl, a1 + i, b1 + j, wi1 * t1)
-    if rig_b == 0:
-        for i in range(k):
-            # rows of B0 and B1 coefficient i in (beta, gamma, delta), times h_BB
-            x0 = one_v * bb[i]
-            y0 = one_v * bs[i]
-            z0 = -bb[i]
-            x1 = v * qb[i]
-            y1 = v * qs[i]
-            z1 = qb[i]
-            p0 = h[13, 13] * x0 + h[14, 13] * y0 + h[15, 13] * z0
-            q0 = h[13, 14] * x0 + h[14, 14] * y0 + h[15, 14] * z0
-            s0 = h[13, 15] * x0 + h[14, 15] * y0 + h[15, 15] * z0
-            p1 = h[13, 13] * x1 + h[14, 13] * y1 + h[15, 13] * z1
-            q1 = h[13, 14] * x1 + h[14, 14] * y1 + h[15, 14] * z1
-            s1 = h[13, 15] * x1 + h[14, 15] * y1 + h[15, 15] * z1
-            for j in range(k):
-                c0x = one_v * bb[j]
-                c0y = one_v * bs[j]
-                c0z = -bb[j]
-                c1x = v * qb[j]
-                c1y = v * qs[j]
-                c1z = qb[j]
-                if j >= i:
-                    add_sym(local, base, nl, b0 + i, b0 + j, p0 * c0x + q0 * c0y + s0 * c0z)
-                    add_sym(local, base, nl, b1 + i, b1 + j, p1 * c1x + q1 * c1y + s1 * c1z)
-                add_sym(local, base, nl, b0 + i, b1 + j, p0 * c1x + q0 * c1y + s0 * c1z)
+                val = hx[3 * n + r, j]
+                wp.atomic_add(blocks, base + r * bsz + 3 + j, val)
+                wp.atomic_add(blocks, base_t + (3 + j) * bsz + r, val)
 
 
 @wp.func
-def scatter_blocks(local: wp.array(dtype=wp.float64), base: int, nl: int, k: int, tid: int,
-                   slots: wp.array(dtype=wp.int32), blocks: wp.array(dtype=wp.float64)):
-    """Add the pass's local Hessian into its node-pair blocks: local dof i belongs to node
-    i // 3 (coordinates) or (i - 12) // k (sections) of (A0, A1, B0, B1), at index i % 3 or
-    3 + (i - 12) % k of the node's 3 + k dofs; pair p's 16 blocks are
-    ``slots[16 p + 4 n_i + n_j]`` with its nodes in (a0, a1, b0, b1) order (pass 1 has A =
-    b: its node n is the pair's (n + 2) % 4)."""
-    bsz = 3 + k
-    pair = tid // 2
-    for i in range(nl):
-        ni = i // 3
-        li = i % 3
-        if i >= 12:
-            ni = (i - 12) // k
-            li = 3 + (i - 12) % k
-        if tid % 2 == 1:
-            ni = (ni + 2) % 4
-        for j in range(nl):
-            val = local[base + i * nl + j]
-            if val == f64(0.0):
-                continue
-            nj = j // 3
-            lj = j % 3
-            if j >= 12:
-                nj = (j - 12) // k
-                lj = 3 + (j - 12) % k
-            if tid % 2 == 1:
-                nj = (nj + 2) % 4
-            slot = slots[pair * 16 + ni * 4 + nj]
-            wp.atomic_add(blocks, (slot * bsz + li) * bsz + lj, val)
+def scatter_coeff(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp.int32),
+                  pair: int, flip: int, bsz: int, k: int, n: int, m: int, hc: matKd,
+                  upper: int):
+    """Add the coefficients' block of nodes (n, m) (``hc``, k x k; ``upper``: a diagonal
+    block held as its upper triangle) into the node-pair block (n, m), and, for n != m,
+    its transpose into (m, n)."""
+    base = _slot_base(slots, pair, flip, n, m, bsz)
+    if upper != 0:
+        for i in range(k):
+            for j in range(k):
+                val = hc[i, j]
+                if j < i:
+                    val = hc[j, i]
+                wp.atomic_add(blocks, base + (3 + i) * bsz + 3 + j, val)
+        return
+    base_t = _slot_base(slots, pair, flip, m, n, bsz)
+    for i in range(k):
+        for j in range(k):
+            val = hc[i, j]
+            wp.atomic_add(blocks, base + (3 + i) * bsz + 3 + j, val)
+            wp.atomic_add(blocks, base_t + (3 + j) * bsz + 3 + i, val)
 
 
 #: The variants: energy only, energy with derivatives, energy with the samples' report.

@@ -243,7 +243,7 @@ def default_coarse_nodes(nodes: int) -> int | None:
     return REFINE_FROM if 2 * nodes > 3 * REFINE_FROM else None
 
 #: How a sectioned scene's load path runs (:func:`tightknot.loading.tie.path_scene`).
-SECTION_PATHS = ("final", "full")
+SECTION_PATHS = ("auto", "final", "full")
 
 
 @dataclass(frozen=True)
@@ -280,11 +280,13 @@ class LoadPath:
                                      "(tightknot.loading.refine)",
                                      default_text=f"{REFINE_FROM} for a rod of more than "
                                      f"{3 * REFINE_FROM // 2} vertices, else off", metavar="N")
-    section_path: str = param("final", SECTION_PATHS, "",
+    section_path: str = param("auto", SECTION_PATHS, "",
                               "the sectioned level's load path: final (relax, tighten and "
                               "pull at the compliant level, the sections' equilibrium solved "
                               "under the final load; an open knot's target Lambda_OC sought "
-                              "again there) or full (every load step with the sections)")
+                              "again there), full (every load step with the sections: a "
+                              "pulled knot's equilibrium can depend on its path) or auto "
+                              "(final for a closed knot, full for an open one)")
 
 
 #: The loads of an open knot's pull: a run gives exactly one of them.

@@ -47,8 +47,8 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
 #: coarse count that its vertex count implies (``default_coarse_nodes``), and writes no
 #: pictures; the device is the sweep's, not the case's; it sweeps the built-in knots from
 #: their parametric starts, not a user's start curve or an ideal start (``tie --start``,
-#: ``--start-shape``); a sectioned case runs tie()'s default path to its equilibrium
-#: (``section_path`` "final"), which that path does not change.
+#: ``--start-shape``); a sectioned case runs tie()'s default path (``section_path``
+#: "auto"), as the open knots' sweep path pulls with the sections.
 NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
                  "coarse_nodes", "color_by", "device", "start", "units", "columns",
                  "start_shape", "section_path")
