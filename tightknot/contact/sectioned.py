@@ -371,15 +371,17 @@ class SectionedLayer(ContactLayer):
     # -- contact between deformed boundaries ---------------------------------------------
     def _margins(self, x: np.ndarray, extra: np.ndarray, rest: np.ndarray) -> np.ndarray:
         """Each edge's reach [m]: its largest boundary radius (the rest radius grown by 10 %
-        for compression, plus 1.5 times its vertices' coefficients' absolute sums) and half
-        its length (a partner's surface extends half an edge past its vertices)."""
+        for compression, plus 1.5 times its vertices' mode amplitudes, sum_n sqrt(a_n^2 +
+        b_n^2), each) and half its length (a partner's surface extends half an edge past its
+        vertices)."""
         ev = self._ev
         length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
         reach = 1.1 * self.edge_r0 * np.maximum(1.0, (length / rest) ** (-self.edge_nu))
         if extra.size:
             k = self.section.coeff_count
             vsum = np.zeros(self.model.vertex_count)
-            vsum[~self.vertex_rigid] = np.abs(extra.reshape(-1, k)).sum(axis=1)
+            pairs = extra.reshape(-1, k // 2, 2)
+            vsum[~self.vertex_rigid] = np.sqrt(np.sum(pairs * pairs, axis=2)).sum(axis=1)
             reach += 1.5 * (vsum[ev[:, 0]] + vsum[ev[:, 1]])
         return reach + 0.5 * length
 

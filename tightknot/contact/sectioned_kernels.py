@@ -190,11 +190,12 @@ def rotate_modes(c: vecKd, angle: wp.float64, k: int, transpose: int) -> vecKd:
 
 
 @wp.func
-def abs_sum(c: vecKd, k: int) -> wp.float64:
-    """sum |c_j| over the first k entries."""
+def amplitude_sum(c: vecKd, k: int) -> wp.float64:
+    """sum_n sqrt(a_n^2 + b_n^2) [m]: no boundary point lies farther than this from the
+    mean radius (|a cos n phi + b sin n phi| <= sqrt(a^2 + b^2))."""
     t = f64(0.0)
-    for j in range(k):
-        t += wp.abs(c[j])
+    for j in range(k // 2):
+        t += wp.sqrt(c[2 * j] * c[2 * j] + c[2 * j + 1] * c[2 * j + 1])
     return t
 
 
@@ -506,21 +507,22 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         tb = vec_b / lb
         rig_a = edge_rigid[ea]
         rig_b = edge_rigid[eb]
-        # The sections of the edges' vertices, the second one's in the edge's frame.
+        # The sections of the edges' vertices (the second one's turned into the edge's
+        # frame below, once the pass is known to reach).
         ca0 = load_section(coeff_in, vertex_offset[va[0]], k)
-        ca1 = rotate_modes(load_section(coeff_in, vertex_offset[va[1]], k), end_twist_in[ea],
-                           k, 1)
+        ca1 = load_section(coeff_in, vertex_offset[va[1]], k)
         cb0 = load_section(coeff_in, vertex_offset[vb[0]], k)
-        cb1 = rotate_modes(load_section(coeff_in, vertex_offset[vb[1]], k), end_twist_in[eb],
-                           k, 1)
+        cb1 = load_section(coeff_in, vertex_offset[vb[1]], k)
         lam_a = la / rest_in[ea]
         lam_b = lb / rest_in[eb]
-        # Largest boundary radii: the mean radius is at most r0 lam^-nu, and over the
-        # partner's reach (v in [-1/2, 3/2]) |c(v)| sums to at most 1.5 (|c_0| + |c_1|).
-        r_a_max = edge_r0[ea] * wp.pow(lam_a, -edge_nu[ea]) + wp.max(abs_sum(ca0, k),
-                                                                     abs_sum(ca1, k))
-        r_b_max = edge_r0[eb] * wp.pow(lam_b, -edge_nu[eb]) + f64(1.5) * (abs_sum(cb0, k)
-                                                                         + abs_sum(cb1, k))
+        # Largest boundary radii: the mean radius is at most r0 lam^-nu, a vertex's modes
+        # move the boundary by at most their amplitudes' sum (turning keeps each mode's
+        # amplitude), and over the partner's reach (v in [-1/2, 3/2]) the interpolation
+        # weighs the two vertices by at most 1.5 each.
+        r_a_max = edge_r0[ea] * wp.pow(lam_a, -edge_nu[ea]) + wp.max(amplitude_sum(ca0, k),
+                                                                     amplitude_sum(ca1, k))
+        r_b_max = edge_r0[eb] * wp.pow(lam_b, -edge_nu[eb]) + f64(1.5) * (
+            amplitude_sum(cb0, k) + amplitude_sum(cb1, k))
         if rig_a != 0:
             r_a_max = edge_r0[ea]
         if rig_b != 0:
@@ -529,6 +531,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             energy_out[tid] = energy
             pen_max_out[tid] = pen_max
             return
+        ca1 = rotate_modes(ca1, end_twist_in[ea], k, 1)
+        cb1 = rotate_modes(cb1, end_twist_in[eb], k, 1)
         if wp.static(derivatives):
             fa = frame_derivatives(d1_ref_in[ea], t_ref_in[ea], vec_a)
             fb = frame_derivatives(d1_ref_in[eb], t_ref_in[eb], vec_b)
