@@ -816,29 +816,19 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 bsz = 3 + k
                 for n in range(4):
                     for m in range(4):
-                        nn = n
-                        mm = m
-                        if flip == 1:
-                            nn = (n + 2) % 4
-                            mm = (m + 2) % 4
-                        base = slots_in[pair * 16 + nn * 4 + mm] * bsz * bsz
+                        base = _slot_base(slots_in, pair, flip, n, m, bsz)
                         for r in range(3):
                             for c in range(3):
                                 wp.atomic_add(blocks_out, base + r * bsz + c,
                                               h_xx[3 * n + r, 3 * m + c])
-                # coordinates against coefficients (and their transposes)
+                # each deformable side's coefficients against the coordinates and among
+                # themselves, then A's against B's
                 if rig_a == 0:
-                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, h_xa0)
-                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, h_xa1)
-                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 0, h_a0a0, 1)
-                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 1, h_a1a1, 1)
-                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 1, h_a0a1, 0)
+                    scatter_side(blocks_out, slots_in, pair, flip, bsz, k, 0, h_xa0, h_xa1,
+                                 h_a0a0, h_a1a1, h_a0a1)
                 if rig_b == 0:
-                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 2, h_xb0)
-                    scatter_x_coeff(blocks_out, slots_in, pair, flip, bsz, k, 3, h_xb1)
-                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 2, 2, h_b0b0, 1)
-                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 3, 3, h_b1b1, 1)
-                    scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 2, 3, h_b0b1, 0)
+                    scatter_side(blocks_out, slots_in, pair, flip, bsz, k, 2, h_xb0, h_xb1,
+                                 h_b0b0, h_b1b1, h_b0b1)
                 if rig_a == 0 and rig_b == 0:
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 2, h_a0b0, 0)
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 3, h_a0b1, 0)
@@ -878,6 +868,20 @@ def scatter_x_coeff(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp
                 val = hx[3 * n + r, j]
                 wp.atomic_add(blocks, base + r * bsz + 3 + j, val)
                 wp.atomic_add(blocks, base_t + (3 + j) * bsz + r, val)
+
+
+@wp.func
+def scatter_side(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp.int32),
+                 pair: int, flip: int, bsz: int, k: int, first: int, hx0: mat12xKd,
+                 hx1: mat12xKd, h00: matKd, h11: matKd, h01: matKd):
+    """Add one side's coefficient blocks (its vertices: nodes ``first`` and ``first`` + 1):
+    against the coordinates (``hx0``, ``hx1``), its two diagonal blocks (upper triangles
+    ``h00``, ``h11``) and the block between its vertices (``h01``)."""
+    scatter_x_coeff(blocks, slots, pair, flip, bsz, k, first, hx0)
+    scatter_x_coeff(blocks, slots, pair, flip, bsz, k, first + 1, hx1)
+    scatter_coeff(blocks, slots, pair, flip, bsz, k, first, first, h00, 1)
+    scatter_coeff(blocks, slots, pair, flip, bsz, k, first + 1, first + 1, h11, 1)
+    scatter_coeff(blocks, slots, pair, flip, bsz, k, first, first + 1, h01, 0)
 
 
 @wp.func
