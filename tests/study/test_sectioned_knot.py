@@ -3,16 +3,19 @@ converges, keeps its type, and its summary reads width, pressure and area off th
 its load path at the compliant level ends at the equilibrium of the full sectioned path; an
 open knot's target length is sought again with the sections; the level's bad input."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from tightknot.contact.law import RadialComplianceLaw
+from tightknot.contact.report import contact_report
 from tightknot.contact.sectioned import SectionedLayer, SectionSettings
 from tightknot.knots.scenes import closed_trefoil, open_trefoil
 from tightknot.loading.batch import tie_batch
 from tightknot.loading.pull import knot_length, tie_to_lambda
 from tightknot.loading.tie import path_scene, tie
-from tightknot.study.run import run_knot
+from tightknot.study.run import calibration_range, run_knot
 
 
 @pytest.fixture(scope="module")
@@ -130,3 +133,20 @@ def test_auto_pulls_an_open_knot_with_its_sections() -> None:
     assert path_scene(opened) is opened
     assert path_scene(opened, "final") is not opened
     assert path_scene(closed, "full") is closed
+
+
+def test_sections_thinner_than_the_fem_judged_are_said(sectioned_run) -> None:
+    """A sectioned run whose sections' area falls below the smallest A/A0 the FEM
+    cross-check judged (0.69, the wrap's deepest level) says so in its summary's
+    warnings; the tied trefoil (A/A0 0.92) does not."""
+    scene, run = sectioned_run
+    cal = scene.contact.calibration
+    assert cal.judged_area_ratio == pytest.approx(0.6927)
+    st = run.result.system.state
+    rep = contact_report(scene.contact, st.x, run.result.system.rest, st)
+    ok = calibration_range(scene, rep, st.x, run.result.system.rest)
+    assert not any("area" in w for w in ok["warnings"])
+    thin = dataclasses.replace(rep, area_ratio=np.minimum(rep.area_ratio, 0.43))
+    out = calibration_range(scene, thin, st.x, run.result.system.rest)
+    assert out["outside_calibrated_range"]
+    assert any("A/A0 = 0.43, below the 0.693" in w for w in out["warnings"])

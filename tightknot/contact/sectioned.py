@@ -74,6 +74,8 @@ class SectionCalibration:
         crossing_w_hat: the largest per-side approach w/D0 at which the FEM judged a
             crossing (the indent of the cross-check).
         source: where the numbers come from.
+        judged_area_ratio: the smallest section area A/A0 at which the FEM judged the
+            sections (the cross-check's deepest wrap level); 0 when not given.
     """
 
     decay_length_over_d0: dict[int, float]
@@ -81,6 +83,7 @@ class SectionCalibration:
     calibrated_w_hat: float
     crossing_w_hat: float
     source: str
+    judged_area_ratio: float = 0.0
 
     @classmethod
     def from_json(cls, path: str | Path | None = None) -> SectionCalibration:
@@ -100,7 +103,8 @@ class SectionCalibration:
         date = d.get("provenance", {}).get("date", "?")
         fitted = float(d.get("fem", {}).get("fitted_w_over_d0", [0.0, 0.0])[1])
         return cls(decay, pen, fitted, float(d.get("validated_crossing_w_over_d0", 0.0)),
-                   f"FEM calibration {where.name} ({date})")
+                   f"FEM calibration {where.name} ({date})",
+                   float(d.get("validated_min_area_ratio", 0.0)))
 
     def decay_length(self, n: int) -> tuple[float, bool]:
         """l_n / D0 of mode ``n`` and whether it was measured (else extrapolated)."""

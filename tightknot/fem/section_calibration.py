@@ -75,6 +75,9 @@ def calibrate_section_penalty(modes: range | list[int] = range(4, 13), mesh: str
                 "fitted_w_over_d0": [float(w_fit[0]), float(w_fit[-1])]},
         # The deepest indent level of the FEM cross-check (crosscheck --contact sectioned).
         "validated_crossing_w_over_d0": 0.1215,
+        # The smallest FEM A/A0 the cross-check compares the sections' area at (the wrap's
+        # deepest level, medium mesh; the sectioned level 0.7 points from it).
+        "validated_min_area_ratio": 0.6927,
         "provenance": {"date": datetime.date.today().isoformat(),
                        "function": "tightknot.fem.section_calibration."
                                    "calibrate_section_penalty",

@@ -244,7 +244,8 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
     force is then extrapolated; with the positions ``x`` [m] and rest lengths ``rest`` [m],
     a crossing deeper than the point law's fit, whose core was fitted to line squeezes
     only; a rod that is not incompressible, nu != 0.5, while the law was calibrated on an
-    incompressible solid)."""
+    incompressible solid; at the sectioned level, sections thinner than the FEM judged
+    them, :attr:`~tightknot.contact.sectioned.SectionCalibration.judged_area_ratio`)."""
     law = scene.contact.law
     w_hat = 0.5 * float(np.max(contact.overlap, initial=0.0)) / scene.diameter
     warnings = []
@@ -267,6 +268,12 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
                       else "the point law was fitted to")
             warnings.append(f"a crossing reaches w/D0 = {w_cross:.3g}, beyond the "
                             f"{cross_limit:.3g} {judged} (its force there is extrapolated)")
+        judged = scene.contact.calibration.judged_area_ratio if sectioned else 0.0
+        area = float(np.min(contact.area_ratio, initial=1.0))
+        if area < judged:
+            warnings.append(f"the sections' area falls to A/A0 = {area:.3g}, below the "
+                            f"{judged:.3g} at which the FEM judged them (a section that "
+                            "thin is extrapolated)")
         nus = {r.material.poisson_ratio for r in scene.model.rods}
         if any(abs(nu - 0.5) > 1e-12 for nu in nus):
             warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "
