@@ -44,3 +44,44 @@ def cantilever_tip(load_parameter: float, length: float = 1.0) -> tuple[float, f
     assert sol is not None
     end = sol.sol(length)
     return float(end[2]), float(end[3])
+
+
+def clamped_u_apex_shift(bend_radius: float, leg_length: float) -> float:
+    """How far [m] the apex of a U moves along its axis when the U settles in its clamps:
+    an inextensible elastica, straight at rest, started on a half circle of radius
+    ``bend_radius`` [m] with two straight legs of ``leg_length`` [m], both ends clamped
+    (position and direction) where the legs start. Positive: away from the clamps.
+
+    With theta(s) the tangent angle from the first leg's direction and (p, q) = F/EI the
+    end force over the bending stiffness [1/m^2], the moment balance gives ``theta'' = p
+    sin(theta) - q cos(theta)`` (Antman, "Nonlinear Problems of Elasticity", 2005, ch. 4);
+    the clamps give theta(0) = 0, theta(L) = pi, (x, y)(0) = 0 and (x, y)(L) = (0, 2
+    rho). Solved by collocation with ``scipy.integrate.solve_bvp``, the end force an
+    unknown parameter, independently of the rod code."""
+    # in units of the bend radius (the solver's tolerances are absolute)
+    scale = float(bend_radius)
+    rho = 1.0
+    leg = float(leg_length) / scale
+    length = np.pi * rho + 2.0 * leg
+    s = np.linspace(0.0, length, 801)
+    # the start: leg along +x, half circle, leg along -x
+    arc = np.clip((s - leg) / rho, 0.0, np.pi)
+    x0 = np.where(s < leg, s, np.where(s < leg + np.pi * rho, leg + rho * np.sin(arc),
+                                         leg - (s - leg - np.pi * rho)))
+    y0 = np.where(s < leg, 0.0, np.where(s < leg + np.pi * rho, rho * (1.0 - np.cos(arc)),
+                                         2.0 * rho))
+    dth0 = np.where((s >= leg) & (s <= leg + np.pi * rho), 1.0 / rho, 0.0)
+    guess = np.vstack([arc, dth0, x0, y0])
+
+    def rhs(_s: np.ndarray, y: np.ndarray, p: np.ndarray) -> np.ndarray:
+        th, dth, _x, _y = y
+        return np.vstack([dth, p[0] * np.sin(th) - p[1] * np.cos(th), np.cos(th),
+                          np.sin(th)])
+
+    def bc(ya: np.ndarray, yb: np.ndarray, _p: np.ndarray) -> np.ndarray:
+        return np.array([ya[0], yb[0] - np.pi, ya[2], ya[3], yb[2], yb[3] - 2.0 * rho])
+
+    sol = solve_bvp(rhs, bc, s, guess, p=np.zeros(2), tol=1e-10, max_nodes=200000)
+    if not sol.success:
+        raise RuntimeError(f"clamped-U elastica did not converge: {sol.message}")
+    return float(sol.sol(0.5 * length)[2] - (leg + rho)) * scale
