@@ -16,6 +16,7 @@ from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.system import RodSystem
 from tightknot.verification.elastica import clamped_u_apex_shift
 
+#: Edges of the rod: the clamps hold one edge each, an error first-order in its length.
 EDGES = 800
 
 
@@ -50,7 +51,7 @@ def test_a_clamped_u_settles_as_the_elastica(rho: float, leg: float) -> None:
     assert res.converged, res.reason
     shift = float(system.state.x[edges // 2, 0] - pts[edges // 2, 0])
     ref = clamped_u_apex_shift(rho, leg)
-    # the apex moves by 5 % (long legs) to 10 % (short) of rho; the rod's clamps hold one
-    # edge (rho / 140) rather than a point, and its edges are chords: within 2 % of the
-    # shift (measured: see docs/sectioned_level.md)
+    # the apex moves by 2 % (long legs) to 5 % (short) of rho; the rod's clamps hold a
+    # whole edge, not a point: measured +2.5, +1.35 and +0.75 % at 400, 800 and 1600 edges
+    # (long legs), -0.19, -0.06 and -0.003 % (short legs), so 2 % at 800 edges
     assert shift == pytest.approx(ref, rel=0.02)
