@@ -46,8 +46,8 @@ from tightknot.solvers.continuation import (
     StaticResult,
     StepRecord,
     continuation,
+    static_solve,
 )
-from tightknot.solvers.dynamic import proximal
 from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.program import Coroutine, Program
 from tightknot.solvers.system import RodSystem
@@ -197,11 +197,9 @@ def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> K
     the tightening) the compliant level keeps the same centerline guarantees (the step
     bound and the proximity check act on the centerlines at both levels) at a tenth of the
     cost per Newton iteration. A knot with one equilibrium under the final load reaches
-    it either way: the closed trefoil does (docs/sectioned_level.md). A pulled open knot
-    can have two, and the way there picks one: the 125 mm knot's sections solved at the
-    compliant level's 7.32 N settled at Lambda_OC 10.67 in one run and at 9.81 in another
-    (a change of round-off), where the pull with the sections passes 10.1 at 9.4 N; so
-    "auto" pulls an open knot with its sections all the way."""
+    it either way, as the closed trefoil does; a pulled open knot can have two, and the
+    way there picks one, so "auto" pulls an open knot with its sections all the way
+    (docs/sectioned_level.md measures both)."""
     if section_path not in SECTION_PATHS:
         raise ValueError(f"section_path must be one of {', '.join(SECTION_PATHS)}, got "
                          f"{section_path!r}")
@@ -244,16 +242,14 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     start = system.state.copy()
     # The sections start round at a tight knot's contacts: a longer way than a load
     # step's, hence a relaxation's budget.
-    opts = NewtonOptions(residual_tol=residual_tol, max_iterations=400)
-    r = yield from newton(system, system.free_vector(), opts)
-    iters = r.iterations
-    why = "" if r.converged else f"Newton {r.reason}"
-    if why:
-        steps = load_step_options(1, residual_tol)
-        prox = yield from proximal(system, steps.proximal_dt, steps.proximal_steps,
-                                   steps.newton)
-        iters += prox.newton_iterations
-        why = "" if prox.converged else f"{why}, then proximal steps {prox.reason}"
+    steps = load_step_options(1, residual_tol)
+    r, iters, prox = yield from static_solve(
+        system, dataclasses.replace(steps.newton, max_iterations=400), steps.proximal_dt,
+        steps.proximal_steps, steps.newton)
+    why = ""
+    if not r.converged:
+        why = f"Newton {r.reason}" + (f", then proximal steps {prox}" if prox else
+                                      f": {system.violation}" if system.violation else "")
     types = list(res.knot_types)
     rec = StepRecord(done.t, r)
     if not why:

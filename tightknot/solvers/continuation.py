@@ -113,6 +113,34 @@ StepCallback = Callable[[RodSystem, StepRecord], str | None]
 Predictor = Callable[[RodSystem, float, float], None]
 
 
+def static_solve(p: RodSystem, newton_options: NewtonOptions, proximal_dt: float | None,
+                 proximal_steps: int, proximal_newton: NewtonOptions | None = None
+                 ) -> Coroutine[tuple[NewtonResult, int, str]]:
+    """One static solve of ``p`` at its current load from its state: Newton, then (where it
+    fails, unless the rod passed through itself, and with ``proximal_dt`` set) proximal
+    steps from its last iterate, their solves with ``proximal_newton`` (default the
+    Newton options). Returns the result (``"converged_by_proximal_steps"`` with the
+    residual there when the proximal steps found the equilibrium), the Newton iterations
+    spent, the proximal steps' included, and why the proximal steps stopped ("" when none
+    ran)."""
+    res = yield from newton(p, p.free_vector(), newton_options)
+    iterations = res.iterations
+    prox_reason = ""
+    if not res.converged and proximal_dt is not None and res.reason != "passed_through":
+        # The static path may have a limit point here: descend through it by proximal
+        # (fully damped implicit) steps from the last iterate at this load.
+        prox = yield from proximal(p, proximal_dt, proximal_steps,
+                                   proximal_newton or newton_options)
+        iterations += prox.newton_iterations
+        prox_reason = prox.reason
+        if prox.converged:
+            _, g, _ = yield Evaluate(p, p.free_vector(), True, False)
+            res = NewtonResult(True, res.iterations + prox.newton_iterations,
+                               p.residual_norm(g), 0.0, p.last_split.total,
+                               "converged_by_proximal_steps", res.history)
+    return res, iterations, prox_reason
+
+
 @program
 def continuation(p: RodSystem, options: ContinuationOptions | None = None,
                  callback: StepCallback | None = None, predictor: Predictor | None = None,
@@ -150,18 +178,9 @@ def continuation(p: RodSystem, options: ContinuationOptions | None = None,
         p.set_load(t_next)
         if predictor is not None:
             predictor(p, t, t_next)
-        res = yield from newton(p, system.free_vector(), opt.newton)
-        total_iters += res.iterations
-        if not res.converged and opt.proximal_dt is not None and res.reason != "passed_through":
-            # The static path may have a limit point here: descend through it by proximal
-            # (fully damped implicit) steps from the last iterate at this load.
-            prox = yield from proximal(p, opt.proximal_dt, opt.proximal_steps, opt.newton)
-            total_iters += prox.newton_iterations
-            if prox.converged:
-                _, g, _ = yield Evaluate(p, system.free_vector(), True, False)
-                res = NewtonResult(True, res.iterations + prox.newton_iterations,
-                                   system.residual_norm(g), 0.0, p.last_split.total,
-                                   "converged_by_proximal_steps", res.history)
+        res, iterations, _ = yield from static_solve(p, opt.newton, opt.proximal_dt,
+                                                     opt.proximal_steps)
+        total_iters += iterations
         where = f"load step {len(records) + 1} (from t={t:.6g} to t={t_next:.6g})"
         if not res.converged:
             failed = system.state.copy()
