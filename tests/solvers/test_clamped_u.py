@@ -14,22 +14,16 @@ from tightknot.rods.material import Material
 from tightknot.rods.state import State
 from tightknot.solvers.newton import NewtonOptions, newton
 from tightknot.solvers.system import RodSystem
-from tightknot.verification.elastica import clamped_u_apex_shift
+from tightknot.verification.elastica import clamped_u_apex_shift, u_start
 
 #: Edges of the rod: the clamps hold one edge each, an error first-order in its length.
 EDGES = 800
 
 
 def u_points(rho: float, leg: float, edges: int) -> np.ndarray:
-    """A U [m]: a leg along +x from the origin, a half circle of radius ``rho``, a leg back
-    along -x at y = 2 rho, at ``edges`` equal arc steps."""
-    length = math.pi * rho + 2.0 * leg
-    s = np.linspace(0.0, length, edges + 1)
-    arc = np.clip((s - leg) / rho, 0.0, math.pi)
-    x = np.where(s < leg, s, np.where(s < leg + math.pi * rho, leg + rho * np.sin(arc),
-                                      leg - (s - leg - math.pi * rho)))
-    y = np.where(s < leg, 0.0, np.where(s < leg + math.pi * rho, rho * (1.0 - np.cos(arc)),
-                                        2.0 * rho))
+    """The elastica's start U [m] at ``edges`` equal arc steps."""
+    s = np.linspace(0.0, math.pi * rho + 2.0 * leg, edges + 1)
+    _, x, y = u_start(s, rho, leg)
     return np.column_stack([x, y, np.zeros_like(s)])
 
 

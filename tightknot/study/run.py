@@ -268,12 +268,11 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
                       else "the point law was fitted to")
             warnings.append(f"a crossing reaches w/D0 = {w_cross:.3g}, beyond the "
                             f"{cross_limit:.3g} {judged} (its force there is extrapolated)")
-        judged = scene.contact.calibration.judged_area_ratio if sectioned else 0.0
         area = float(np.min(contact.area_ratio, initial=1.0))
-        if area < judged:
+        if sectioned and area < scene.contact.calibration.judged_area_ratio:
             warnings.append(f"the sections' area falls to A/A0 = {area:.3g}, below the "
-                            f"{judged:.3g} at which the FEM judged them (a section that "
-                            "thin is extrapolated)")
+                            f"{scene.contact.calibration.judged_area_ratio:.3g} at which "
+                            "the FEM judged them (a section that thin is extrapolated)")
         nus = {r.material.poisson_ratio for r in scene.model.rods}
         if any(abs(nu - 0.5) > 1e-12 for nu in nus):
             warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "

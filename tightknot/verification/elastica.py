@@ -46,6 +46,21 @@ def cantilever_tip(load_parameter: float, length: float = 1.0) -> tuple[float, f
     return float(end[2]), float(end[3])
 
 
+def u_start(s: np.ndarray, bend_radius: float, leg_length: float
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The U a clamped-U elastica starts from, at arc lengths ``s`` [m]: a leg of
+    ``leg_length`` [m] along +x from the origin, a half circle of radius ``bend_radius``
+    [m], a leg back along -x at y = 2 ``bend_radius``. Returns the tangent angle from +x
+    [rad] and the coordinates x, y [m]."""
+    rho, leg = float(bend_radius), float(leg_length)
+    arc = np.clip((s - leg) / rho, 0.0, np.pi)
+    on_arc = s < leg + np.pi * rho
+    x = np.where(s < leg, s, np.where(on_arc, leg + rho * np.sin(arc),
+                                      leg - (s - leg - np.pi * rho)))
+    y = np.where(s < leg, 0.0, np.where(on_arc, rho * (1.0 - np.cos(arc)), 2.0 * rho))
+    return arc, x, y
+
+
 def clamped_u_apex_shift(bend_radius: float, leg_length: float) -> float:
     """How far [m] the apex of a U moves along its axis when the U settles in its clamps:
     an inextensible elastica, straight at rest, started on a half circle of radius
@@ -64,12 +79,7 @@ def clamped_u_apex_shift(bend_radius: float, leg_length: float) -> float:
     leg = float(leg_length) / scale
     length = np.pi * rho + 2.0 * leg
     s = np.linspace(0.0, length, 801)
-    # the start: leg along +x, half circle, leg along -x
-    arc = np.clip((s - leg) / rho, 0.0, np.pi)
-    x0 = np.where(s < leg, s, np.where(s < leg + np.pi * rho, leg + rho * np.sin(arc),
-                                         leg - (s - leg - np.pi * rho)))
-    y0 = np.where(s < leg, 0.0, np.where(s < leg + np.pi * rho, rho * (1.0 - np.cos(arc)),
-                                         2.0 * rho))
+    arc, x0, y0 = u_start(s, rho, leg)
     dth0 = np.where((s >= leg) & (s <= leg + np.pi * rho), 1.0 / rho, 0.0)
     guess = np.vstack([arc, dth0, x0, y0])
 
