@@ -66,10 +66,11 @@ def soft_wrap_one_level():
 
 @pytest.fixture(scope="session")
 def clasp_one_level():
-    """The clasp: relaxation in the clamps and one coarse level at a pull of 0.5 D0 (the
-    bends touch from about 0.4 D0 on; about 50 s on 2 shared cores)."""
+    """The clasp: relaxation in the clamps and one coarse level at a pull of 0.7 D0 (the
+    FEM's bends touch from about 0.4 D0 on, the rod model's, clamped at the same points,
+    from about 0.55 D0; about 60 s on 2 shared cores)."""
     pytest.importorskip("felupe")
     pytest.importorskip("ipctk")
     from tightknot.fem import run_scene
 
-    return run_scene("clasp", mesh="coarse", max_pull_over_d0=0.5, steps=1)
+    return run_scene("clasp", mesh="coarse", max_pull_over_d0=0.7, steps=1)

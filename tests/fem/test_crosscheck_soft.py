@@ -29,7 +29,8 @@ def test_compare_arithmetic_gating_and_spread():
     rod = [_rod_step(0.5, approach=0.0), _rod_step(2.1, approach=0.05),
            _rod_step(3.0, approach=0.15)]
     coarse = [_fem_step(0.0, 0.0), _fem_step(2.2, 0.1), _fem_step(3.0, 0.3)]
-    out = compare("clasp", fem, rod, coarse)
+    matched = [_rod_step(0.0), _rod_step(1.9), _rod_step(3.0)]
+    out = compare("clasp", fem, rod, coarse, matched)
     # the level before contact (no pressure) and the one past the approach limit are not
     # compared; the one left is +5 % in force, -1 point in area
     assert len(out["levels"]) == 1
@@ -38,14 +39,27 @@ def test_compare_arithmetic_gating_and_spread():
     assert row["area_points"] == pytest.approx(-0.01)
     assert row["fem_spread_rel"]["force"] == pytest.approx(2.0 / 2.2 - 1.0)
     assert row["met"] == {"force": True, "area": True, "converged": True}
-    # at the FEM's approach 0.1 the rod model's force, linear between 2.1 at 0.05 and 3.0
-    # at 0.15, is 2.55: +27.5 % at the same approach
-    assert row["force_rel_same_approach"] == pytest.approx(0.275)
+    # the diagnostic with the U's kinematics matched: 1.9 against 2.0
+    assert row["force_rel_kinematics_matched"] == pytest.approx(-0.05)
     assert "curvature" not in row["met"]  # the clasp's curvature is reported only
     assert out["passed"]
     rod[1] = _rod_step(2.0 * (1.0 + TARGETS["force_rel"]) * 1.01)
     assert not compare("clasp", fem, rod, None)["passed"]
     assert compare("clasp", fem, rod, None)["levels"][0]["fem_spread_rel"] is None
+
+
+def test_clasp_kinematic_offset():
+    from tightknot.fem.crosscheck_soft import clasp_kinematic_offset
+
+    # the rod model's apex moved out 0.02 D0 more; the FEM's inner side reaches 1.06 R
+    # from its mid fibre, the rod model's round section 0.98 R (A/A0 0.9604), 0.04 D0
+    # less: the rod model's bends touch 2 (0.02 + 0.04) = 0.12 D0 of clamp travel later
+    fem = {"apex_shift_over_d0": 0.10, "inner_offset_over_r": 1.06}
+    rod = {"relaxed_apex_shift_over_d0": 0.12, "relaxed_area_ratio_apex": 0.9604}
+    off = clasp_kinematic_offset(fem, rod)
+    assert off["apex_shift_over_d0"] == pytest.approx(0.02)
+    assert off["inner_side_over_d0"] == pytest.approx(0.04)
+    assert off["clamp_travel_over_d0"] == pytest.approx(0.12)
 
 
 def test_spread_mesh_is_the_next_coarser():
@@ -68,4 +82,9 @@ def test_soft_rows_from_one_coarse_level(soft_wrap_one_level, clasp_one_level):
             assert row["fem_force"] > 0.0 and row["rod_force"] > 0.0
             assert row["met"]["force"] == (abs(row["force_rel"]) <= TARGETS["force_rel"])
             assert level["scenes"][name]["fem_over_rod_time_ratio"] > 1.0
+        # the clasp's diagnostic: the rod model run again with its clamps moved by the
+        # relaxed U's offset (measured 0.12 D0 later at the medium mesh, docs/fem_nip.md)
+        clasp = level["scenes"]["clasp"]
+        assert 0.0 < clasp["kinematic_offset"]["clamp_travel_over_d0"] < 0.3
+        assert clasp["comparison"]["levels"][0]["rod_force_kinematics_matched"] > 0.0
     assert rows["passed"] == rows["levels"]["compliant"]["passed"]

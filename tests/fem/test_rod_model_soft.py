@@ -58,6 +58,25 @@ def test_soft_wrap_statics_and_shared_overlap(soft_wrap_rod):
         assert s["profile_a"][0]["contact_fraction"] > 0.0
 
 
+def test_clasp_rod_model_is_clamped_where_the_fem_clamps():
+    # the FEM scene starts its Rivlin-bent sections with their inner fibres a gap g0
+    # apart, so its centrelines start 2 b' + g0 apart, not D0; the rod model's U's must
+    # end at the same clamp points, or a pull of the clamps means another clasp
+    # (docs/fem_nip.md, "Where the clamps are")
+    from tightknot.fem.rod_model_soft import clasp_centrelines
+    from tightknot.fem.scenes.clasp import inner_fibre_offset
+
+    rho, leg, gap = 1.5 * D0, 1.5 * D0, 0.004 * D0
+    curves, s = clasp_centrelines(rho, leg, D0, initial_gap=gap)
+    b_inner = inner_fibre_offset(rho, 0.5 * D0)
+    assert b_inner == pytest.approx(0.634 * D0, rel=1e-3)  # 3 R (1 - sqrt(1/3))
+    clamp_x = b_inner + 0.5 * gap - rho - leg
+    assert curves[0][0] == pytest.approx([clamp_x, -rho, 0.0], abs=1e-12)
+    assert curves[0][-1] == pytest.approx([clamp_x, rho, 0.0], abs=1e-12)
+    apex = curves[0][len(s) // 2]
+    assert apex[0] - curves[1][len(s) // 2][0] == pytest.approx(2.0 * b_inner + gap)
+
+
 def test_clasp_rod_model_is_symmetric_and_pulls():
     from tightknot.fem.rod_model_soft import clasp_centrelines, rod_clasp
     from tightknot.fem.scenes.clasp import rotate_to_b
@@ -65,11 +84,13 @@ def test_clasp_rod_model_is_symmetric_and_pulls():
     curves, s = clasp_centrelines(1.5 * D0, 1.5 * D0, D0)
     assert np.allclose(curves[1], rotate_to_b(curves[0]))
     assert s[len(s) // 2] == pytest.approx(0.0)  # a vertex at the apex
-    res = rod_clasp([0.4 * D0, 0.6 * D0])
+    res = rod_clasp([0.7 * D0, 0.9 * D0])
     assert res["relaxed"]
     a, b = res["steps"]
     assert a["converged"] and b["converged"]
-    assert 0.0 < a["force"] < b["force"]  # touching at 0.4 D0, pulled harder at 0.6
+    # the round sections start 0.27 D0 apart and the U's open as they relax: touching
+    # from about 0.55 D0 of clamp travel, pulled harder at 0.9
+    assert 0.0 < a["force"] < b["force"]
     # the two U's are images of each other under the half turn: same profiles (the
     # solver's tolerance leaves 1e-6)
     for pa, pb in zip(b["profile_a"], b["profile_b"], strict=True):

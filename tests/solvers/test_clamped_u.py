@@ -1,7 +1,7 @@
 """A rod bent into a U and clamped at both legs settles as the planar elastica says: the
 apex's shift, against :func:`tightknot.verification.elastica.clamped_u_apex_shift`
 (solve_bvp, independent of the rod code). The clasp scenes start from such U's
-(docs/sectioned_level.md: the FEM's U's open far more than this)."""
+(docs/fem_nip.md, "The relaxed U": a thick U's apex moves further, by its bend's stretch)."""
 
 import math
 

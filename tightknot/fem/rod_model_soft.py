@@ -147,13 +147,18 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
 
 
 def clasp_centrelines(bend_radius: float, leg_length: float, diameter: float,
-                      edges_per_d0: int = EDGES_PER_D0) -> tuple[np.ndarray, np.ndarray]:
+                      edges_per_d0: int = EDGES_PER_D0, initial_gap: float = 0.0
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """Both U's of the clasp scene (:mod:`tightknot.fem.scenes.clasp`) as vertex arrays
     [m], clamp to clamp through the apex (an even number of edges, a vertex at the apex),
-    and the rest arc length of each vertex from the apex [m]."""
-    from .scenes.clasp import rotate_to_b, u_centreline
+    and the rest arc length of each vertex from the apex [m]. Placed as the FEM scene
+    places its U's, whose start map thickens the bends' inner sides: the apex centrelines
+    2 b' + ``initial_gap`` [m] apart (:func:`~tightknot.fem.scenes.clasp.inner_fibre_offset`;
+    the FEM's gap is in its ``parameters``), so that both models clamp their rods at the
+    same points; the rod model's round sections then start 2 b' - D0 apart."""
+    from .scenes.clasp import inner_fibre_offset, rotate_to_b, u_centreline
 
-    x_apex = 0.5 * diameter  # touching: the FEM's gap g0 is below the rod's resolution
+    x_apex = inner_fibre_offset(bend_radius, 0.5 * diameter) + 0.5 * initial_gap
     length = 0.5 * math.pi * bend_radius + leg_length
     n_half = int(round(length / diameter * edges_per_d0))
     s = np.linspace(-length, length, 2 * n_half + 1)
@@ -165,15 +170,19 @@ def clasp_centrelines(bend_radius: float, leg_length: float, diameter: float,
 def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
               leg_length_over_d0: float = 1.5, diameter: float = ROD_DIAMETER,
               youngs_modulus: float = YOUNGS_MODULUS, law: Any = None,
-              contact: str = "compliant") -> dict[str, Any]:
+              contact: str = "compliant", initial_gap: float = 0.0) -> dict[str, Any]:
     """The clasp with the rod model: two U's (straight at rest, started on the FEM
-    scene's U, :func:`clasp_centrelines`), each end clamped (its two end vertices held),
+    scene's U and clamped where it clamps its rods, the FEM's start gap ``initial_gap``
+    [m], :func:`clasp_centrelines`), each end clamped (its two end vertices held),
     relaxed, then the clamps moved apart along x by ``pull_levels`` [m] (half each).
 
     Returns per level: ``force`` [N] (the x contact force on A: the pull, by statics),
     ``approach_over_d0`` (D0 minus the apex vertices' distance), ``kappa_d0_apex``,
     ``area_ratio_apex``, ``peak_pressure_over_e``, ``contact_fraction_max``,
-    ``profile_a``/``profile_b`` (from the apex to a clamp); and the wall time.
+    ``profile_a``/``profile_b`` (from the apex to a clamp); before the pull,
+    ``relaxed_apex_shift_over_d0`` (how far the apex moved out along the pull axis as the
+    U settled in its clamps, measured as the FEM scene measures it on its mid fibre) and
+    ``relaxed_area_ratio_apex``; and the wall time.
     """
     from tightknot.knots.curvature import bergou_curvature
     from tightknot.loading.levels import LevelLoad, LevelOptions, LevelPath
@@ -185,7 +194,8 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
     start = time.perf_counter()
     check_contact(contact)
     d0 = diameter
-    curves, s = clasp_centrelines(bend_radius_over_d0 * d0, leg_length_over_d0 * d0, d0)
+    curves, s = clasp_centrelines(bend_radius_over_d0 * d0, leg_length_over_d0 * d0, d0,
+                                  initial_gap=initial_gap)
     model = _builder_rod(curves, d0, youngs_modulus)
     n = len(s) - 1
     apex = n // 2
@@ -203,6 +213,12 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
     # the rods settle in their clamps first (straight at rest, started bent)
     path = LevelPath(system, load, LevelOptions(steps="one", proximal_dt=1e-3), level=0.0)
     relaxed = not Program(path.solve(0.0), "relax").run()
+    # the relaxed apex's shift out along the pull axis: the apex vertex from the clamped
+    # end's (the clamp face's centre), less rho + leg, as the FEM scene measures it
+    xr = system.state.x[va]
+    apex_shift = float(xr[apex, 0] - xr[0, 0]) - (bend_radius_over_d0
+                                                  + leg_length_over_d0) * d0
+    relaxed_area = _profile(_report(term, system), va[apex:], s[apex:], d0)[0]["area_ratio"]
 
     def measure(pull: float) -> dict[str, Any]:
         x = system.state.x
@@ -230,5 +246,7 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
         }
 
     rows = _solve_levels(system, load, list(pull_levels), measure) if relaxed else []
-    return {"steps": rows, "relaxed": relaxed, "wall_time_s": time.perf_counter() - start,
+    return {"steps": rows, "relaxed": relaxed, "relaxed_apex_shift_over_d0": apex_shift / d0,
+            "relaxed_area_ratio_apex": relaxed_area,
+            "wall_time_s": time.perf_counter() - start,
             "vertices": int(model.vertex_count), "contact": contact}

@@ -29,12 +29,15 @@ wants), and the clamps then move apart along x by Delta / 2 each (displacement c
 ``max_pull_over_d0`` = the largest Delta over D0). A clamp holds its end face in place:
 all three displacement components of its nodes.
 
-Outputs per pull level: the pull force F (the x reaction of A's clamps, whole clasp) against
-Delta, its balance with the contact force, the apexes' approach (their section centroids'
-distance below D0) and the nominal approach (far fibres moved in by the stretched
-radius), the apex curvature, the apex sections' A/A0, peak pressures, the largest contact
-width fraction; ``profile_a`` and ``profile_b`` along each rod (per node layer: A/A0, L_c,
-p_max/E), the contact patch maps ``patch_a`` and ``patch_b`` (rest arc length, angle around
+Outputs of the relaxation (``relaxed``, :func:`_relaxed_u`): how far the apex moved out
+along the pull axis as the U settled in its clamps, the apex's axial force, the stretch and
+curvature of its mid fibre, and where its inner and outer sides lie. Outputs per pull level:
+the pull force F (the x reaction of A's clamps, whole clasp) against Delta, its balance with
+the contact force, the apexes' approach (their section centroids' distance below D0) and the
+nominal approach (far fibres moved in by the stretched radius), the apex curvature, the apex
+sections' A/A0, peak pressures, the largest contact width fraction; ``profile_a`` and
+``profile_b`` along each rod (per node layer: A/A0, L_c, p_max/E), the contact patch maps
+``patch_a`` and ``patch_b`` (rest arc length, angle around
 the section from the inner side, p/E of each loaded node).
 """
 
@@ -70,13 +73,18 @@ from ._common import (
 from ._pair import GAP_OVER_DHAT, bodies_solid, make_barrier, nodal_contact
 from ._sections import RodSections, contact_half_length
 
-REFINED_ARC_OVER_D0: float = 1.6
-"""Arc length from the apex [D0] meshed uniformly: a rod wrapped around its partner's tube
-(radius D0 for the two centrelines) over up to 90 degrees stays in contact over
-pi/2 D0 ~ 1.6 D0 of its arc."""
+CONTACT_ARC_OVER_D0: float = 1.6
+"""Arc length from the apex [D0] whose lateral faces can touch the partner: a rod wrapped
+around its partner's tube (radius D0 for the two centrelines) over up to 90 degrees stays
+in contact over pi/2 D0 ~ 1.6 D0 of its arc."""
 
-AXIAL_FINE_CELLS: dict[str, int] = {"coarse": 8, "medium": 12, "fine": 16}
-"""Uniform hexahedra over the refined arc (0.2, 0.13, 0.1 D0)."""
+AXIAL_CELLS_PER_D0: dict[str, float] = {"coarse": 5.0, "medium": 7.5, "fine": 10.0}
+"""Hexahedra per D0 of arc length, uniform from the apex to the clamp (cells of 0.2, 0.13
+and 0.1 D0). Uniform because the whole U bends as it settles in its clamps, and trilinear
+hexahedra lock in bending the more the longer they are: cells that grow along the rod
+stiffen its outer bend and legs against its apex and change the settled shape (cells
+growing to 3 D0 moved the apex 4.3 times as far as uniform cells, cells of twice the
+apex's 1.3 times; docs/fem_nip.md, "The bend's mesh")."""
 
 DEFAULT_STEPS: int = 6
 """Default number of pull levels."""
@@ -151,6 +159,68 @@ def u_centreline(s: np.ndarray, rho: float, x_c: float) -> tuple[np.ndarray, np.
     return c, n_in
 
 
+def axial_nodes(length: float, cell: float) -> np.ndarray:
+    """Rest arc lengths [m] of the node layers from the apex (0) to a clamp (``length``
+    [m]): uniform cells of at most ``cell`` [m]."""
+    return np.linspace(0.0, length, max(1, math.ceil(length / cell - 1e-9)) + 1)
+
+
+def inner_fibre_offset(rho: float, radius: float) -> float:
+    """How far [m] the start map puts the inner fibre (b = ``radius``) from the centreline
+    of a U of bend radius ``rho`` [m]: b' = rho (1 - sqrt(1 - 2 R / rho)) (Rivlin's bending
+    of an incompressible block, as in :func:`_run_one`), more than R: the scene starts the
+    two bends with these fibres a small gap apart, so its centrelines start 2 b' apart
+    (1.27 D0 at rho = 1.5 D0), and its clamps where that puts them."""
+    return rho * (1.0 - math.sqrt(1.0 - 2.0 * radius / rho))
+
+
+def _relaxed_u(x_all: np.ndarray, idx_a: np.ndarray, ref: np.ndarray, s_nodes: np.ndarray,
+               radius: float, clamp_reaction: np.ndarray, rho: float, leg: float,
+               youngs_modulus: float, centroid: Any) -> dict[str, float]:
+    """Rod A's U relaxed in its clamps, before the pull, from the current positions
+    ``x_all`` [m] and the reactions [N] on A's clamp nodes (half section):
+
+    - ``apex_shift_over_d0``: how far the apex's mid fibre (the reference section's centre,
+      what the rod model's centreline is) moved out along the pull axis, from the clamp
+      face's centre, less rho + leg; ``apex_centroid_shift_over_d0`` the same for the apex
+      section's area centroid;
+    - ``apex_axial_force_over_ea``: the axial force at the apex section over E A0, positive
+      in tension, by statics of the quarter model without contact: the clamp's reaction
+      along y (the apex's tangent), whole section;
+    - ``apex_mid_fibre_stretch``: the mid fibre's stretch over the first cell;
+      ``apex_kappa_d0``: its curvature (three layers and their mirror images);
+    - ``inner_offset_over_r``, ``outer_offset_over_r``: the apex's inner (toward the bend's
+      centre) and outer surface points from its mid fibre along x, over R (1 for a round
+      section that keeps its size)."""
+    from tightknot.knots.curvature import bergou_curvature
+
+    xa = x_all[idx_a]
+
+    def node(a: float, b: float, j: int) -> np.ndarray:
+        hit = np.flatnonzero(np.isclose(ref[:, 0], a, atol=1e-9 * radius)
+                             & np.isclose(ref[:, 1], b, atol=1e-9 * radius)
+                             & np.isclose(ref[:, 2], s_nodes[j], atol=1e-9 * radius))
+        return xa[hit[0]]
+
+    last = len(s_nodes) - 1
+    mid = np.array([node(0.0, 0.0, j) for j in range(3)]) * np.array([1.0, 1.0, 0.0])
+    mirror = mid[1:][::-1] * np.array([1.0, -1.0, 1.0])
+    kappa = float(bergou_curvature(np.vstack([mirror, mid]), closed=False)[2])
+    d0 = 2.0 * radius
+    clamp_x = node(0.0, 0.0, last)[0]
+    return {
+        "apex_shift_over_d0": float(mid[0, 0] - clamp_x - (rho + leg)) / d0,
+        "apex_centroid_shift_over_d0": float(centroid(xa, 0)[0] - centroid(xa, last)[0]
+                                             - (rho + leg)) / d0,
+        "apex_axial_force_over_ea": float(2.0 * clamp_reaction[:, 1].sum())
+        / (youngs_modulus * math.pi * radius**2),
+        "apex_mid_fibre_stretch": float(np.linalg.norm(mid[1] - mid[0]) / s_nodes[1]),
+        "apex_kappa_d0": kappa * d0,
+        "inner_offset_over_r": float(mid[0, 0] - node(0.0, radius, 0)[0]) / radius,
+        "outer_offset_over_r": float(node(0.0, -radius, 0)[0] - mid[0, 0]) / radius,
+    }
+
+
 def rotate_to_b(x: np.ndarray) -> np.ndarray:
     """Rod B's points from rod A's: the proper rotation (x, y, z) -> (-x, z, y), by 180
     degrees about the line x = 0, y = z (also for displacements and forces)."""
@@ -177,13 +247,12 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
     half = wrap.half_disk(radius, wrap.SECTION_POINTS[level])
     section = fem.Mesh(points=np.asarray(half.points) * np.array([-1.0, 1.0]),
                        cells=np.asarray(half.cells)[:, ::-1], cell_type="quad")
-    s_nodes = wrap.axial_nodes(length, REFINED_ARC_OVER_D0 * diameter,
-                               AXIAL_FINE_CELLS[level], wrap.AXIAL_COARSE_CELLS[level])
+    s_nodes = axial_nodes(length, diameter / AXIAL_CELLS_PER_D0[level])
     rod = extrude(section, s_nodes)
     body, (idx_a, idx_b), field, solid = bodies_solid([rod, rod], youngs_modulus)
     ref = np.asarray(rod.points)
     lat = lateral_faces(rod, radius)
-    near = np.all((ref[lat, 2] < (REFINED_ARC_OVER_D0 + 0.4) * diameter)
+    near = np.all((ref[lat, 2] < (CONTACT_ARC_OVER_D0 + 0.4) * diameter)
                   & (ref[lat, 1] > -0.5 * radius), axis=1)
     faces_a = lat[near]
     faces = np.vstack([faces_a, faces_a + rod.npoints])
@@ -196,7 +265,7 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
     on_arc = ref[:, 2] <= 0.5 * math.pi * rho
     b_bent = np.where(on_arc, rho * (1.0 - np.sqrt(1.0 - 2.0 * ref[:, 1] / rho)), ref[:, 1])
 
-    inner = rho * (1.0 - math.sqrt(1.0 - 2.0 * radius / rho))  # the inner fibre's b'
+    inner = inner_fibre_offset(rho, radius)
 
     def u_shape_of(gap: float) -> np.ndarray:
         """Both rods' start positions [m] with the gap ``gap`` [m] between the apexes'
@@ -265,6 +334,10 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
         area = 0.5 * np.linalg.norm(np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 1]), axis=1)
         return (area[:, None] * c.mean(axis=1)).sum(axis=0) / area.sum()
 
+    relaxed = _relaxed_u(body.points + field[0].values, idx_a, ref, s_nodes, radius,
+                         problem.residual().reshape(-1, 3)[clamp_a], rho,
+                         leg_length_over_d0 * diameter, youngs_modulus, centroid)
+
     def measure(pull: float) -> dict[str, Any]:
         x = body.points + field[0].values
         r = problem.residual()
@@ -332,6 +405,7 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
                       "along x by pull / 2 each",
         },
         "relaxation_iterations": int(relax),
+        "relaxed": relaxed,
         "steps": table,
         "newton_iterations_total": int(sum(problem.iterations)) + int(relax),
         "wall_time_s": time.perf_counter() - start,
