@@ -188,3 +188,53 @@ def test_options_name_the_parameter_and_its_range() -> None:
         SearchOptions(step_ratio=0.9)
     with pytest.raises(ValueError, match="needs the level"):
         LevelPath(*_rod(), ONE)
+
+
+def test_a_solve_that_passed_through_is_refused_without_proximal_steps(monkeypatch) -> None:
+    # Two parallel rods, the second pulled at its middle through the first with no contact
+    # energy (only a promise to keep them apart): Newton stops with "passed_through". The
+    # proximal steps would start from that crossed iterate, so the level path refuses the
+    # solve instead (the one static solve, solvers.continuation.static_solve), names the
+    # reason, and keeps its last equilibrium.
+    import tightknot.loading.levels as levels
+    from tightknot.rods.term import EnergyTerm
+    from tightknot.solvers import continuation as cont
+
+    class Apart(EnergyTerm):
+        name = "apart"
+        keeps_apart = True
+
+        def max_step(self, x, dx, rest):
+            return min(1.0, 0.02 * DIAMETER / max(float(np.abs(dx).max()), 1e-300))
+
+        def evaluate(self, x, rest, want_grad, want_hess):
+            n = x.shape[0]
+            return 0.0, (np.zeros((n, 3)) if want_grad else None), (
+                (np.zeros(0, int), np.zeros(0, int), np.zeros(0)) if want_hess else None)
+
+    b = RodBuilder(twist=False)
+    s = np.linspace(0.0, 5 * DIAMETER, 11)
+    b.add_rod(np.c_[s, np.zeros(11), np.zeros(11)], DIAMETER, MAT)
+    b.add_rod(np.c_[s, np.full(11, 0.2 * DIAMETER), np.zeros(11)], DIAMETER, MAT)
+    model = b.finalize()
+    load = LevelLoad()
+    bcs = BoundaryConditions(model)
+    for rod in (0, 1):
+        bcs.pin(rod, 0).pin(rod, -1)
+        for v in range(11):
+            bcs.fix_components(rod, v, (0, 2))
+    bcs.force(1, 5, lambda t: load(t) * np.array([0.0, -1.0, 0.0]))
+    system = RodSystem(model, State.initial(model), bcs)
+    system.add_term(Apart())
+    path = LevelPath(system, load, LevelOptions(steps="one", proximal_dt=1e-3),
+                     level=0.0)
+    start = system.state.x.copy()
+
+    def no_proximal(*args, **kwargs):
+        raise AssertionError("proximal steps after the rod passed through itself")
+
+    monkeypatch.setattr(cont, "proximal", no_proximal)
+    monkeypatch.setattr(levels, "proximal", no_proximal, raising=False)  # a copy's import
+    why = _run(path.solve(0.5))
+    assert "passed_through" in why
+    assert path.level == 0.0 and np.array_equal(system.state.x, start)

@@ -43,9 +43,13 @@ from typing import Protocol
 
 import numpy as np
 
-from tightknot.solvers.continuation import ContinuationOptions, StepRecord, continuation
-from tightknot.solvers.dynamic import proximal
-from tightknot.solvers.newton import NewtonOptions, newton
+from tightknot.solvers.continuation import (
+    ContinuationOptions,
+    StepRecord,
+    continuation,
+    static_solve,
+)
+from tightknot.solvers.newton import NewtonOptions
 from tightknot.solvers.program import Coroutine
 from tightknot.solvers.system import RodSystem
 
@@ -159,7 +163,7 @@ class LevelOptions:
         proximal_dt: first time step [s] of the proximal steps
             (:func:`~tightknot.solvers.dynamic.proximal`) that descend from a failed static
             solve to the next equilibrium (a limit point: a loop flips, the contact set
-            jumps); None: no such fallback.
+            jumps), not after the rod passed through itself; None: no such fallback.
         proximal_steps: their budget.
         predictor: the start of each solve (None: the last equilibrium).
         name, unit: the level's name and unit in messages.
@@ -302,18 +306,10 @@ class LevelPath:
             # The predictor's jump is part of the way a knot type could change.
             system.history.insert(0, saved.x.copy())
         self.solves += 1
-        r = yield from newton(system, system.free_vector(), opts.newton)
-        self.iterations += r.iterations
-        why = ""
-        if not r.converged:
-            ok = False
-            if opts.proximal_dt is not None:
-                prox = yield from proximal(system, opts.proximal_dt, opts.proximal_steps,
-                                           opts.newton)
-                self.iterations += prox.newton_iterations
-                ok = prox.converged
-            if not ok:
-                why = f"Newton {r.reason} at {opts.name} {value:.4g} {opts.unit}"
+        r, iterations, _ = yield from static_solve(system, opts.newton, opts.proximal_dt,
+                                                   opts.proximal_steps)
+        self.iterations += iterations
+        why = "" if r.converged else f"Newton {r.reason} at {opts.name} {value:.4g} {opts.unit}"
         if not why and self.check is not None:
             why = self.check(system, StepRecord(1.0, r), value) or ""
         if why:
