@@ -197,20 +197,8 @@ def test_a_solve_that_passed_through_is_refused_without_proximal_steps(monkeypat
     # solve instead (the one static solve, solvers.continuation.static_solve), names the
     # reason, and keeps its last equilibrium.
     import tightknot.loading.levels as levels
-    from tightknot.rods.term import EnergyTerm
+    from tests.rods.test_proximity import _Apart  # no energy, a promise to keep apart
     from tightknot.solvers import continuation as cont
-
-    class Apart(EnergyTerm):
-        name = "apart"
-        keeps_apart = True
-
-        def max_step(self, x, dx, rest):
-            return min(1.0, 0.02 * DIAMETER / max(float(np.abs(dx).max()), 1e-300))
-
-        def evaluate(self, x, rest, want_grad, want_hess):
-            n = x.shape[0]
-            return 0.0, (np.zeros((n, 3)) if want_grad else None), (
-                (np.zeros(0, int), np.zeros(0, int), np.zeros(0)) if want_hess else None)
 
     b = RodBuilder(twist=False)
     s = np.linspace(0.0, 5 * DIAMETER, 11)
@@ -225,7 +213,7 @@ def test_a_solve_that_passed_through_is_refused_without_proximal_steps(monkeypat
             bcs.fix_components(rod, v, (0, 2))
     bcs.force(1, 5, lambda t: load(t) * np.array([0.0, -1.0, 0.0]))
     system = RodSystem(model, State.initial(model), bcs)
-    system.add_term(Apart())
+    system.add_term(_Apart())  # its step bound is 0.02 of its D = DIAMETER
     path = LevelPath(system, load, LevelOptions(steps="one", proximal_dt=1e-3),
                      level=0.0)
     start = system.state.x.copy()
