@@ -37,8 +37,8 @@ the contact force, the apexes' approach (their section centroids' distance below
 nominal approach (far fibres moved in by the stretched radius), the apex curvature, the apex
 sections' A/A0, peak pressures, the largest contact width fraction; ``profile_a`` and
 ``profile_b`` along each rod (per node layer: A/A0, L_c, p_max/E), the contact patch maps
-``patch_a`` and ``patch_b`` (rest arc length, angle around
-the section from the inner side, p/E of each loaded node).
+``patch_a`` and ``patch_b`` (rest arc length, angle around the section from the inner side,
+p/E of each loaded node).
 """
 
 from __future__ import annotations
