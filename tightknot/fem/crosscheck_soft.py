@@ -202,18 +202,18 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None) -> dict[str
         scenes = {}
         for name in ROW_SCENES:
             ref = fem.get(f"{name}@{spread}") if spread else None
+            matched = rod.get(f"{name}_matched")
             scenes[name] = {
                 "comparison": compare(name, fem[name]["steps"], rod[name]["steps"],
                                       ref["steps"] if ref else None,
-                                      rod[f"{name}_matched"]["steps"]
-                                      if f"{name}_matched" in rod else None),
+                                      matched["steps"] if matched else None),
                 "fem_wall_time_s": fem[name]["wall_time_s"],
                 "rod_wall_time_s": rod[name]["wall_time_s"],
                 "fem_over_rod_time_ratio": fem[name]["wall_time_s"] / rod[name]["wall_time_s"],
                 "rod_steps": rod[name]["steps"],
             }
-            if f"{name}_matched" in rod:
-                scenes[name]["kinematic_offset"] = rod[f"{name}_matched"]["kinematic_offset"]
+            if matched:
+                scenes[name]["kinematic_offset"] = matched["kinematic_offset"]
         levels[contact] = {
             "scenes": scenes,
             "rod_wall_time_s": time.perf_counter() - start,

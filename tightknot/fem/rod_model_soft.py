@@ -153,12 +153,12 @@ def clasp_centrelines(bend_radius: float, leg_length: float, diameter: float,
     [m], clamp to clamp through the apex (an even number of edges, a vertex at the apex),
     and the rest arc length of each vertex from the apex [m]. Placed as the FEM scene
     places its U's, whose start map thickens the bends' inner sides: the apex centrelines
-    2 b' + ``initial_gap`` [m] apart (:func:`~tightknot.fem.scenes.clasp.inner_fibre_offset`;
+    2 b' + ``initial_gap`` [m] apart (:func:`~tightknot.fem.scenes.clasp.start_apex_x`;
     the FEM's gap is in its ``parameters``), so that both models clamp their rods at the
     same points; the rod model's round sections then start 2 b' - D0 apart."""
-    from .scenes.clasp import inner_fibre_offset, rotate_to_b, u_centreline
+    from .scenes.clasp import rotate_to_b, start_apex_x, u_centreline
 
-    x_apex = inner_fibre_offset(bend_radius, 0.5 * diameter) + 0.5 * initial_gap
+    x_apex = start_apex_x(bend_radius, 0.5 * diameter, initial_gap)
     length = 0.5 * math.pi * bend_radius + leg_length
     n_half = int(round(length / diameter * edges_per_d0))
     s = np.linspace(-length, length, 2 * n_half + 1)

@@ -174,6 +174,13 @@ def inner_fibre_offset(rho: float, radius: float) -> float:
     return rho * (1.0 - math.sqrt(1.0 - 2.0 * radius / rho))
 
 
+def start_apex_x(rho: float, radius: float, gap: float) -> float:
+    """x [m] of rod A's apex on the start U's centreline with the inner fibres a ``gap``
+    [m] apart (:func:`inner_fibre_offset`); its clamps lie at this less rho and the leg.
+    The rod model's clasp places its U's by the same number, so both clamp alike."""
+    return inner_fibre_offset(rho, radius) + 0.5 * gap
+
+
 def _relaxed_u(x_all: np.ndarray, idx_a: np.ndarray, ref: np.ndarray, s_nodes: np.ndarray,
                radius: float, clamp_reaction: np.ndarray, rho: float, leg: float,
                youngs_modulus: float, centroid: Any) -> dict[str, float]:
@@ -270,7 +277,7 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
     def u_shape_of(gap: float) -> np.ndarray:
         """Both rods' start positions [m] with the gap ``gap`` [m] between the apexes'
         inner sides."""
-        centre, n_in = u_centreline(ref[:, 2], rho, inner + 0.5 * gap - rho)
+        centre, n_in = u_centreline(ref[:, 2], rho, start_apex_x(rho, radius, gap) - rho)
         a = centre + b_bent[:, None] * n_in + (-ref[:, [0]]) * np.array([0.0, 0.0, 1.0])
         return np.vstack([a, rotate_to_b(a)])
 
