@@ -52,10 +52,10 @@ def test_clasp_kinematic_offset():
     from tightknot.fem.crosscheck_soft import clasp_kinematic_offset
 
     # the rod model's apex moved out 0.02 D0 more; the FEM's inner side reaches 1.06 R
-    # from its mid fibre, the rod model's round section 0.98 R (A/A0 0.9604), 0.04 D0
-    # less: the rod model's bends touch 2 (0.02 + 0.04) = 0.12 D0 of clamp travel later
+    # from its mid fibre, the rod model's section 0.98 R (a round one of A/A0 0.9604), 0.04
+    # D0 less: the rod model's bends touch 2 (0.02 + 0.04) = 0.12 D0 of clamp travel later
     fem = {"apex_shift_over_d0": 0.10, "inner_offset_over_r": 1.06}
-    rod = {"relaxed_apex_shift_over_d0": 0.12, "relaxed_area_ratio_apex": 0.9604}
+    rod = {"relaxed_apex_shift_over_d0": 0.12, "relaxed_inner_side_over_r": 0.98}
     off = clasp_kinematic_offset(fem, rod)
     assert off["apex_shift_over_d0"] == pytest.approx(0.02)
     assert off["inner_side_over_d0"] == pytest.approx(0.04)

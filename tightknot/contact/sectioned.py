@@ -47,6 +47,7 @@ import warp as wp
 from tightknot.contact import sectioned_kernels as sk
 from tightknot.contact.layer import ContactLayer
 from tightknot.contact.section_modes import mode_stiffness
+from tightknot.contact.section_shift import MIN_CHORD, SectionShift
 from tightknot.rods.model import Model
 from tightknot.rods.staging import Staging
 from tightknot.rods.term import BlockHessian
@@ -134,12 +135,21 @@ class SectionSettings:
         penalty: penalty stiffness over E/D0 [-] (pressure kappa pen, kappa = penalty E/D0);
             None: the calibrated one of ``max_mode`` (:class:`SectionCalibration`).
         onset: the penalty's rounded onset over D0 [-].
+        bend_shift: centre each section's boundary on the tight bend's offset centreline,
+            x + (nu R^2 / 2) kappa (Saint-Venant's anticlastic flexure,
+            :mod:`tightknot.contact.section_shift`); False (the default): on the
+            centreline. Off by default: it brings the clasp's first contact to the FEM's
+            but moves the wraps away from it (docs/sectioned_level.md, "The bend's section
+            shift").
+        bend_shift_chord: the least chord [D0] the shift's curvature is taken over.
     """
 
     max_mode: int = 8
     samples: int = 64
     penalty: float | None = None
     onset: float = 1e-4
+    bend_shift: bool = False
+    bend_shift_chord: float = 1.0
 
     def __post_init__(self) -> None:
         if (isinstance(self.max_mode, bool) or int(self.max_mode) != self.max_mode
@@ -151,6 +161,15 @@ class SectionSettings:
                              f"{4 * self.max_mode}, got {self.samples!r}")
         if self.penalty is not None and not (math.isfinite(self.penalty) and self.penalty > 0.0):
             raise ValueError(f"section penalty must be finite and > 0, got {self.penalty!r}")
+        if not isinstance(self.bend_shift, bool):
+            raise ValueError(f"section bend_shift must be true or false, got "
+                             f"{self.bend_shift!r}")
+        if not (isinstance(self.bend_shift_chord, (int, float))
+                and math.isfinite(self.bend_shift_chord)
+                and self.bend_shift_chord >= MIN_CHORD):
+            raise ValueError(f"section bend_shift_chord must be >= {MIN_CHORD} D0 (shorter "
+                             f"chords turn the zigzag mode over), got "
+                             f"{self.bend_shift_chord!r}")
         if not (math.isfinite(self.onset) and 0.0 < self.onset < 0.01):
             raise ValueError(f"section penalty onset must be in (0, 0.01) D0, got "
                              f"{self.onset!r}")
@@ -227,6 +246,10 @@ class SectionedLayer(ContactLayer):
             nxt[m.joint_edge[:, 0]] = np.arange(m.joint_count)
         self._next_joint = nxt
         self._section_edges = np.flatnonzero(~self.edge_rigid)
+        #: The offset centreline the boundaries are centred on (None: the centreline).
+        self.shift = (SectionShift(m, np.array([r not in rigid for r in range(len(m.rods))]),
+                                   self.section.bend_shift_chord)
+                      if self.section.bend_shift else None)
         # Nodes of the Hessian's blocks: each vertex's 3 coordinates and its K coefficients.
         nodes = m.vertex_count
         pos = m.vertex_dof.astype(np.int64)[:, None] + np.arange(3)
@@ -472,6 +495,9 @@ class SectionedLayer(ContactLayer):
         m = self.model
         rest = np.asarray(rest, dtype=np.float64)
         self.energy.last_rest = rest.copy()
+        shifted = self.shift.at(x, rest) if self.shift is not None else None
+        if shifted is not None:
+            x = shifted.x
         wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
         data = self._state_arrays(extra, *frames, rest, arcs, rod_len)
         npairs = pairs.shape[0]
@@ -517,6 +543,11 @@ class SectionedLayer(ContactLayer):
             hess = BlockHessian(self._node_dofs,
                                 np.stack([keys // m.vertex_count, keys % m.vertex_count], axis=1),
                                 out["blocks"])
+        if shifted is not None:
+            # derivatives over the offset centreline carried to the centreline
+            if hess is not None:
+                hess = shifted.pull_back_hessian(hess, g_x)
+            g_x = shifted.pull_back_gradient(g_x)
         return energy, g_x, g_c, hess
 
     def _empty_blocks(self) -> BlockHessian:
@@ -540,6 +571,14 @@ class SectionedLayer(ContactLayer):
         np.add.at(flat, (slot * b + self._dof_local[rows]) * b + self._dof_local[cols], vals)
 
     # -- measurements ----------------------------------------------------------------------
+    def boundary_centres(self, x: np.ndarray, rest: np.ndarray) -> np.ndarray:
+        """The centres [m] (V, 3) of the sections' boundaries at positions ``x`` [m] and
+        edge rest lengths ``rest`` [m]: the offset centreline with ``bend_shift``, else
+        ``x`` itself."""
+        if self.shift is None:
+            return np.asarray(x, dtype=np.float64)
+        return self.shift.at(x, np.asarray(rest, dtype=np.float64)).x
+
     def section_report(self, x: np.ndarray, extra: np.ndarray,
                        frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
                        ) -> dict[str, np.ndarray]:
@@ -564,6 +603,7 @@ class SectionedLayer(ContactLayer):
         n_e, n_v = m.edge_count, m.vertex_count
         ng = len(self.settings.gauss[0])
         ms = self.section.samples
+        x = self.boundary_centres(x, rest)  # the boundaries' centres and mean stretch
         wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
         data = self._state_arrays(extra, *frames, rest, arcs, rod_len)
         pen = np.zeros((n_e, ng, ms))

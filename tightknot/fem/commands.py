@@ -84,6 +84,10 @@ def register(subparsers: Any) -> None:
     fem.add_argument("--section-modes", type=int, default=8, metavar="N",
                      help="crosscheck --contact sectioned: the sections' highest Fourier mode "
                           "N, in [4, 12] (default 8)")
+    fem.add_argument("--section-bend-shift", action="store_true",
+                     help="crosscheck --contact sectioned: centre the sections on the tight "
+                          "bend's offset centreline (Saint-Venant's anticlastic shift; "
+                          "docs/sectioned_level.md)")
     fem.add_argument("--fem-json", default=None, metavar="FILE",
                      help="crosscheck only: reuse the FEM results of an earlier crosscheck "
                           "report FILE (its fem_results) instead of running the FEM")
@@ -185,7 +189,7 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
                              f"fem_results ({err})")
         report = crosscheck(mesh=args.mesh or DEFAULT_MESH, fem_results=fem_results,
                             contact=args.contact, section_modes=args.section_modes,
-                            soft=not args.no_soft)
+                            soft=not args.no_soft, bend_shift=args.section_bend_shift)
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))
     if args.json is None:

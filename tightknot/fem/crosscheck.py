@@ -341,10 +341,11 @@ def _warm_up() -> float:
 
 
 def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = None,
-               contact: str = "compliant", section_modes: int = 8, soft: bool = True
-               ) -> dict[str, Any]:
+               contact: str = "compliant", section_modes: int = 8, soft: bool = True,
+               bend_shift: bool = False) -> dict[str, Any]:
     """Run indent and wrap with the FEM (``mesh``) and the rod model at the contact level
-    ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N) and
+    ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N,
+    ``bend_shift``: its sections centred on the bend's offset centreline) and
     compare them; at the compliant level with ``soft``, also the two-soft-rod scenes
     soft_wrap and clasp (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, its
     compliant level's ``passed`` part of the report's).
@@ -365,7 +366,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     if contact == "sectioned":
         from tightknot.contact.sectioned import SectionSettings
 
-        SectionSettings(max_mode=section_modes)  # bad input before the FEM runs
+        SectionSettings(max_mode=section_modes, bend_shift=bend_shift)  # bad input first
     fem_results = dict(fem_results or {})
     start = time.perf_counter()
     if "indent" not in fem_results:
@@ -374,7 +375,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         fem_results["wrap"] = run_scene("wrap", mesh=mesh, convergence=False)
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
     if contact == "sectioned":
-        return _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start)
+        return _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift)
     warm = _warm_up()
     rod_ind = _rod_indent_like(fem_ind)
     rod_wr = _rod_wrap_like(fem_wrap)
@@ -446,14 +447,15 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
 
 
 def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
-                      section_modes: int, start: float) -> dict[str, Any]:
+                      section_modes: int, start: float, bend_shift: bool = False
+                      ) -> dict[str, Any]:
     """The cross-check of the sectioned level (:mod:`tightknot.fem.rod_sectioned`): force,
     A/A0, L_c and (wrap) curvature at every level, against the targets."""
     from tightknot.contact.sectioned import SectionSettings
 
     from .rod_sectioned import rod_indent_sectioned, rod_wrap_sectioned
 
-    section = SectionSettings(max_mode=section_modes)
+    section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift)
     t0 = time.perf_counter()
     rod_indent_sectioned([0.01 * ROD_DIAMETER], length_over_d0=1.5, section=section)
     warm = time.perf_counter() - t0
@@ -495,6 +497,7 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
         "schema": "tightknot.fem_crosscheck/1",
         "contact": "sectioned",
         "section_modes": section_modes,
+        "section_bend_shift": bend_shift,
         "penalty_over_e_per_d0": rod_ind["penalty"],
         "mesh": mesh,
         "approach_limit_over_d0": APPROACH_LIMIT,

@@ -84,17 +84,17 @@ def clasp_kinematic_offset(fem_relaxed: dict[str, float], rod: dict[str, Any]
     FEM's, from the two relaxed U's (before the pull): twice (both rods) the sum of how
     much further out the rod model's apex moved (``apex_shift``, its centreline against
     the FEM's mid fibre) and how much further the FEM's inner side reaches from its mid
-    fibre than the rod model's round section (``inner_side``: the FEM's
-    ``inner_offset_over_r`` R against R sqrt(A/A0) at the rod model's relaxed apex).
+    fibre than the rod model's section from its centreline (``inner_side``: the FEM's
+    ``inner_offset_over_r`` R against the rod model's ``relaxed_inner_side_over_r`` R, its
+    section's radius and, where the level shifts its sections, their shift).
     Negative: earlier."""
     shift = rod["relaxed_apex_shift_over_d0"] - fem_relaxed["apex_shift_over_d0"]
-    inner = 0.5 * (fem_relaxed["inner_offset_over_r"]
-                   - rod["relaxed_area_ratio_apex"] ** 0.5)
+    inner = 0.5 * (fem_relaxed["inner_offset_over_r"] - rod["relaxed_inner_side_over_r"])
     return {"apex_shift_over_d0": shift, "inner_side_over_d0": inner,
             "clamp_travel_over_d0": 2.0 * (shift + inner)}
 
 
-def _rod_runs(fem: dict[str, dict], contact: str) -> dict[str, dict]:
+def _rod_runs(fem: dict[str, dict], contact: Any) -> dict[str, dict]:
     """The rod model at the FEM's load levels and parameters, at level ``contact``; with
     the FEM's relaxed U's at hand also the clasp with the kinematics matched (key
     "clasp_matched", its ``kinematic_offset``, :func:`clasp_kinematic_offset`)."""
@@ -188,17 +188,20 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
             "passed": bool(rows) and all(all(x["met"].values()) for x in rows)}
 
 
-def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None) -> dict[str, Any]:
+def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
+              section: Any = None) -> dict[str, Any]:
     """The report's ``soft_scenes`` entry: the FEM runs (:func:`fem_runs`), the rod model at
-    each of :data:`CONTACT_LEVELS`, and their comparisons (:func:`compare`); ``passed``
-    is the compliant level's (both scenes, every target, the rod model at least 1000
-    times faster than the FEM on each scene)."""
+    each of :data:`CONTACT_LEVELS` (the sectioned level with the settings ``section``
+    where given), and their comparisons (:func:`compare`); ``passed`` is the compliant
+    level's (both scenes, every target, the rod model at least 1000 times faster than the
+    FEM on each scene)."""
     fem = fem_runs(mesh, fem_results)
     spread = spread_mesh(mesh)
     levels = {}
     for contact in CONTACT_LEVELS:
         start = time.perf_counter()
-        rod = _rod_runs(fem, contact)
+        rod = _rod_runs(fem, section if (contact == "sectioned" and section is not None)
+                        else contact)
         scenes = {}
         for name in ROW_SCENES:
             ref = fem.get(f"{name}@{spread}") if spread else None

@@ -36,11 +36,29 @@ CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed", "sectioned")
 """Contact levels of the rod model here (:func:`contact_term`)."""
 
 
-def check_contact(contact: str) -> str:
-    """``contact`` if it is one of :data:`CONTACT_LEVELS`, else ValueError naming them."""
-    if contact not in CONTACT_LEVELS:
+def check_contact(contact: Any) -> Any:
+    """``contact`` if it is one of :data:`CONTACT_LEVELS` or a sectioned level's
+    :class:`~tightknot.contact.sectioned.SectionSettings`, else ValueError naming them."""
+    from tightknot.contact.sectioned import SectionSettings
+
+    if not isinstance(contact, SectionSettings) and contact not in CONTACT_LEVELS:
         raise ValueError(f"contact must be one of {CONTACT_LEVELS}, got {contact!r}")
     return contact
+
+
+def _name(contact: Any) -> str:
+    """The level's name of ``contact`` (a name, or a sectioned level's settings)."""
+    from tightknot.knots.scenes import contact_name
+
+    return contact_name(contact)
+
+
+def _centres(term: Any, system: Any) -> np.ndarray:
+    """The centres [m] of the rod model's sections at the system's state: the centreline,
+    or the offset one of a sectioned level whose sections shift in a bend."""
+    centres = getattr(term, "boundary_centres", None)
+    x = system.state.x
+    return x if centres is None else centres(x, system.rest)
 
 
 def contact_term(model: Any, contact: str = "compliant", law: Any = None) -> Any:
@@ -112,7 +130,8 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     s_b = np.linspace(-2 * d0, 2 * d0, n_obs + 1)
 
     def measure(tension: float) -> dict[str, Any]:
-        x = system.state.x
+        # the axis the FEM's nominal one stands for: the sections' centres
+        x = _centres(term, system)
         g = system.term_gradient(term)
         xr = x[rod_v]
         e = np.linalg.norm(np.diff(xr, axis=0), axis=1)
@@ -143,7 +162,7 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
 
     rows = _solve_levels(system, load, list(tension_levels), measure)
     return {"steps": rows, "wall_time_s": time.perf_counter() - start,
-            "vertices": int(model.vertex_count), "contact": contact}
+            "vertices": int(model.vertex_count), "contact": _name(contact)}
 
 
 def clasp_centrelines(bend_radius: float, leg_length: float, diameter: float,
@@ -182,7 +201,8 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
     ``profile_a``/``profile_b`` (from the apex to a clamp); before the pull,
     ``relaxed_apex_shift_over_d0`` (how far the apex moved out along the pull axis as the
     U settled in its clamps, measured as the FEM scene measures it on its mid fibre) and
-    ``relaxed_area_ratio_apex``; and the wall time.
+    ``relaxed_area_ratio_apex`` and ``relaxed_inner_side_over_r`` (how far the apex's
+    inner side reaches from the centreline, over R); and the wall time.
     """
     from tightknot.knots.curvature import bergou_curvature
     from tightknot.loading.levels import LevelLoad, LevelOptions, LevelPath
@@ -219,6 +239,13 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
     apex_shift = float(xr[apex, 0] - xr[0, 0]) - (bend_radius_over_d0
                                                   + leg_length_over_d0) * d0
     relaxed_area = _profile(_report(term, system), va[apex:], s[apex:], d0)[0]["area_ratio"]
+    # the inner side's reach from the centreline [R]: the round section's radius, plus the
+    # boundary's shift toward the bend's centre (-x at A's apex) where the level has one
+    inner = relaxed_area ** 0.5
+    shift = getattr(term, "shift", None)
+    if shift is not None:
+        moved = shift.at(system.state.x, system.rest).x[va[apex]] - xr[apex]
+        inner -= float(moved[0]) / (0.5 * d0)
 
     def measure(pull: float) -> dict[str, Any]:
         x = system.state.x
@@ -247,6 +274,6 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
 
     rows = _solve_levels(system, load, list(pull_levels), measure) if relaxed else []
     return {"steps": rows, "relaxed": relaxed, "relaxed_apex_shift_over_d0": apex_shift / d0,
-            "relaxed_area_ratio_apex": relaxed_area,
+            "relaxed_area_ratio_apex": relaxed_area, "relaxed_inner_side_over_r": inner,
             "wall_time_s": time.perf_counter() - start,
-            "vertices": int(model.vertex_count), "contact": contact}
+            "vertices": int(model.vertex_count), "contact": _name(contact)}

@@ -79,7 +79,7 @@ def _vertex_section(layer: Any, system: Any, v: int
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     """Vertex ``v`` of rod 0 at the state: its frame's t, d1, d2 (of the edge that stores its
     section), its section's coefficients [m] and mean radius R [m] (the area's, thinned by
-    the edge's stretch, incompressible)."""
+    the stretch of the boundaries' centre line, incompressible)."""
     st = system.state
     m = layer.model
     k = layer.section.coeff_count
@@ -88,7 +88,8 @@ def _vertex_section(layer: Any, system: Any, v: int
     t, d1 = st.t_ref[e], st.d1_ref[e]
     c = st.extra[layer.vertex_offset[v]:layer.vertex_offset[v] + k]
     a, b = m.edge_vertex[e]
-    lam = float(np.linalg.norm(st.x[b] - st.x[a]) / system.rest[e])
+    centres = layer.boundary_centres(st.x, system.rest)
+    lam = float(np.linalg.norm(centres[b] - centres[a]) / system.rest[e])
     return t, d1, np.cross(t, d1), c, math.sqrt(layer.edge_r0[e] ** 2 / lam - 0.5 * float(c @ c))
 
 
@@ -96,30 +97,33 @@ def _far_fibre_axis(layer: Any, system: Any, verts: np.ndarray, axis_y: float,
                     r_stretched: float) -> np.ndarray:
     """The nominal axis at vertices ``verts`` of the wrapped rod (module docstring): the
     far fibre, opposite the direction to the cylinder axis (the line y = ``axis_y``, z = 0
-    along x), moved toward it by ``r_stretched`` [m]."""
+    along x), moved toward it by ``r_stretched`` [m] (the far fibre of the section about
+    its boundary's centre)."""
     from tightknot.contact.sectioned_reference import mode_basis
 
     st = system.state
+    centres = layer.boundary_centres(st.x, system.rest)
     out = np.empty((len(verts), 3))
     for i, v in enumerate(verts):
         t, d1, d2, c, big_r = _vertex_section(layer, system, v)
         # the direction to the cylinder's axis (the x axis at y = axis_y), normal to t
-        toward = np.array([0.0, axis_y - st.x[v, 1], -st.x[v, 2]])
+        toward = np.array([0.0, axis_y - centres[v, 1], -centres[v, 2]])
         toward -= (toward @ t) * t
         away = -toward / np.linalg.norm(toward)
         phi = math.atan2(away @ d2, away @ d1)
         r = big_r + float(mode_basis(layer.modes, np.array([phi]))[0][0] @ c)
-        out[i] = st.x[v] + (r - r_stretched) * away
+        out[i] = centres[v] + (r - r_stretched) * away
     return out
 
 
 def _centroid_axis(layer: Any, system: Any, verts: np.ndarray) -> np.ndarray:
     """The centroids [m] of the deformed sections at vertices ``verts`` of rod 0: the
-    centre x_v plus (1 / 3A) int r^3 (cos phi d1 + sin phi d2) dphi, A = (1/2) int r^2 dphi
+    boundary's centre x_v (:meth:`~tightknot.contact.sectioned.SectionedLayer.
+    boundary_centres`) plus (1 / 3A) int r^3 (cos phi d1 + sin phi d2) dphi, A = (1/2) int r^2 dphi
     (the area centroid of a star-shaped section), by the midpoint rule on 720 angles."""
     from tightknot.contact.sectioned_reference import mode_basis
 
-    st = system.state
+    centres = layer.boundary_centres(system.state.x, system.rest)
     phi = 2.0 * math.pi * (np.arange(720) + 0.5) / 720
     basis = mode_basis(layer.modes, phi)[0]
     out = np.empty((len(verts), 3))
@@ -129,7 +133,7 @@ def _centroid_axis(layer: Any, system: Any, verts: np.ndarray) -> np.ndarray:
         area = 0.5 * float(np.mean(r * r)) * 2.0 * math.pi
         mx = float(np.mean(r**3 * np.cos(phi))) * 2.0 * math.pi / (3.0 * area)
         my = float(np.mean(r**3 * np.sin(phi))) * 2.0 * math.pi / (3.0 * area)
-        out[i] = st.x[v] + mx * d1 + my * d2
+        out[i] = centres[v] + mx * d1 + my * d2
     return out
 
 
@@ -159,7 +163,9 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
         total = float(np.linalg.norm(g[obs_v].sum(axis=0)))
         rep = _report(layer, system)
         xr = x[rod_v]
-        e = np.linalg.norm(np.diff(xr, axis=0), axis=1)
+        # the nominal circle's radius from the stretch of the boundaries' centre line
+        xb = layer.boundary_centres(x, system.rest)[rod_v]
+        e = np.linalg.norm(np.diff(xb, axis=0), axis=1)
         stretch = float(0.5 * (e[mid - 1] + e[mid]) / (2.0 * half / n_rod))
         r_str = 0.5 * d0 / math.sqrt(stretch)
         near = rod_v[mid - 3:mid + 4]

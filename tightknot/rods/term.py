@@ -36,11 +36,22 @@ class BlockHessian:
             for a term's own dof j; -1 where a node has none), (nodes, b) int64.
         keys: the node pairs (row node, column node) of the blocks, (U, 2) int64, unique.
         blocks: the blocks, (U, b, b) [J per unit of the two dofs].
+        full_rows, full_cols: whether each block's rows (columns) past a node's first 3
+            dofs (its position) may be nonzero, (U,) bool; None: all may. A block that
+            couples positions only then adds no structural zeros to the matrix.
     """
 
     node_dofs: np.ndarray
     keys: np.ndarray
     blocks: np.ndarray
+    full_rows: np.ndarray | None = None
+    full_cols: np.ndarray | None = None
+
+    def masks(self) -> tuple[np.ndarray, np.ndarray]:
+        """``full_rows`` and ``full_cols``, all True where not given."""
+        every = np.ones(self.keys.shape[0], dtype=bool)
+        return (every if self.full_rows is None else self.full_rows,
+                every if self.full_cols is None else self.full_cols)
 
 
 class EnergyTerm(Protocol):

@@ -384,13 +384,26 @@ class RodSystem:
                 and np.array_equal(cache["indices"], hmat.indices))
         nodes = own.node_dofs.shape[0]
         new_keys = own.keys[:, 0] * nodes + own.keys[:, 1]
+        rows_in, cols_in = own.masks()
         if same:
             kept = cache["keys"]
             at = np.minimum(np.searchsorted(kept, new_keys), kept.size - 1)
-            same = bool(np.all(kept[at] == new_keys))
+            same = bool(np.all(kept[at] == new_keys)
+                        and not np.any(rows_in & ~cache["full_rows"][at])
+                        and not np.any(cols_in & ~cache["full_cols"][at]))
         if not same:
-            keys = new_keys if cache is None else np.union1d(cache["keys"], new_keys)
-            cache = self._own_union(hmat, own.node_dofs, keys)
+            if cache is None:
+                keys, full_r, full_c = new_keys, rows_in, cols_in
+            else:
+                keys = np.union1d(cache["keys"], new_keys)
+                full_r = np.zeros(keys.size, dtype=bool)
+                full_c = np.zeros(keys.size, dtype=bool)
+                old_at = np.searchsorted(keys, cache["keys"])
+                full_r[old_at], full_c[old_at] = cache["full_rows"], cache["full_cols"]
+                new_at = np.searchsorted(keys, new_keys)
+                full_r[new_at] |= rows_in
+                full_c[new_at] |= cols_in
+            cache = self._own_union(hmat, own.node_dofs, keys, full_r, full_c)
             at = np.searchsorted(keys, new_keys)
         b = own.blocks.shape[1]
         blocks = np.zeros((cache["keys"].size, b, b))
@@ -401,9 +414,12 @@ class RodSystem:
         size = cache["size"]
         return sp.csc_matrix((data, cache["indices_u"], cache["indptr_u"]), shape=(size, size))
 
-    def _own_union(self, hmat: sp.csc_matrix, node_dofs: np.ndarray, keys: np.ndarray) -> dict:
+    def _own_union(self, hmat: sp.csc_matrix, node_dofs: np.ndarray, keys: np.ndarray,
+                   full_rows: np.ndarray, full_cols: np.ndarray) -> dict:
         """The union of ``hmat``'s pattern with the node blocks of node-pair ``keys`` (row
-        node x nodes + column node), and each entry's slot in it (kept as the cache)."""
+        node x nodes + column node; past a node's position, only the rows ``full_rows``
+        and the columns ``full_cols`` of each block), and each entry's slot in it (kept as
+        the cache)."""
         n, n_own = self.pattern.n, self.dof_term.dof_count
         nodes = node_dofs.shape[0]
         index = np.concatenate([self.pattern.free_index, n + np.arange(n_own)])
@@ -412,7 +428,10 @@ class RodSystem:
         shape = (keys.size, b, b)
         rows = np.broadcast_to(node_free[keys // nodes][:, :, None], shape)
         cols = np.broadcast_to(node_free[keys % nodes][:, None, :], shape)
-        valid = ((rows >= 0) & (cols >= 0)).ravel()
+        local = np.arange(b)
+        valid = ((rows >= 0) & (cols >= 0)
+                 & ((local[None, :, None] < 3) | full_rows[:, None, None])
+                 & ((local[None, None, :] < 3) | full_cols[:, None, None])).ravel()
         size = n + n_own
         e_cols = np.repeat(np.arange(n), np.diff(hmat.indptr))
         all_r = np.concatenate([hmat.indices, rows.ravel()[valid]]).astype(np.int64)
@@ -421,7 +440,8 @@ class RodSystem:
         union.sum_duplicates()
         u_cols = np.repeat(np.arange(size, dtype=np.int64), np.diff(union.indptr))
         slots = np.searchsorted(u_cols * size + union.indices, all_c * size + all_r)
-        cache = {"keys": keys, "indptr": hmat.indptr.copy(), "indices": hmat.indices.copy(),
+        cache = {"keys": keys, "full_rows": full_rows, "full_cols": full_cols,
+                 "indptr": hmat.indptr.copy(), "indices": hmat.indices.copy(),
                  "valid": valid, "slot_e": slots[:hmat.nnz], "slot_t": slots[hmat.nnz:],
                  "indptr_u": union.indptr, "indices_u": union.indices, "size": size}
         self._own_pattern = cache
