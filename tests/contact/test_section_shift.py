@@ -220,3 +220,23 @@ def test_a_longer_chord_reaches_further_and_shifts_fewer_end_vertices() -> None:
     assert two.count < one.count
     moved = np.linalg.norm(two.at(x, rest).x - x, axis=1)
     assert np.count_nonzero(moved) == two.count
+
+
+def test_knot_measures_read_the_sections_centres() -> None:
+    # Lambda_OC, gaps and contact maps are measured on the surfaces the contact keeps
+    # apart: with the shift, on the offset centreline (a knot's shifted sections touch
+    # where their centrelines are more than the summed radii apart).
+    from tightknot.knots.scenes import closed_trefoil, contact_centres, vertex_radii
+
+    shifted = closed_trefoil(16.37, nodes=60, contact=SectionSettings(bend_shift=True))
+    plain = closed_trefoil(16.37, nodes=60, contact="compliant")
+    x, rest = shifted.model.vertex_initial_position, shifted.model.edge_rest_length
+    centres = contact_centres(shifted, x, rest)
+    assert np.array_equal(centres, shifted.contact.boundary_centres(x, rest))
+    assert np.max(np.linalg.norm(centres - x, axis=1)) > 0.01 * shifted.diameter
+    assert contact_centres(plain, x, rest) is x
+    # the sections thin by the offset centreline's (mean fibre's) stretch
+    ev = shifted.model.edge_vertex
+    lam = np.linalg.norm(centres[ev[:, 1]] - centres[ev[:, 0]], axis=1) / rest
+    r_e, _ = vertex_radii(shifted, x, rest)
+    assert np.allclose(r_e, shifted.model.edge_radius * lam ** -0.5, rtol=1e-12)

@@ -709,12 +709,24 @@ def bending_force_scale(scene: KnotScene) -> float:
     return mat.youngs_modulus * math.pi * scene.diameter**4 / 64.0 / scene.diameter**2
 
 
+def contact_centres(scene: KnotScene, x: np.ndarray, rest: np.ndarray) -> np.ndarray:
+    """The centres [m] (V, 3) of the sections the contact sees, for centerline ``x`` and
+    edge rest lengths ``rest``: ``x`` itself, or a sectioned level's offset centreline
+    where its sections shift in a bend
+    (:meth:`tightknot.contact.sectioned.SectionedLayer.boundary_centres`). Gaps, contact
+    maps and Lambda_OC measured on them see the surfaces the contact keeps apart."""
+    centres = getattr(scene.contact, "boundary_centres", None)
+    return x if centres is None else centres(x, rest)
+
+
 def vertex_radii(scene: KnotScene, x: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, ...]:
     """Deformed edge radii r0 lam^-nu [m] (the rest radius for a rigid tube; lam the stretch
-    that thins the section: the rod's mean, the edge's own, or a window mean) and
-    their vertex averages [m], for centerline ``x`` and edge rest lengths ``rest``."""
+    that thins the section: the rod's mean, the edge's own, or a window mean; of the
+    sections' centres, :func:`contact_centres`) and their vertex averages [m], for
+    centerline ``x`` and edge rest lengths ``rest``."""
     m = scene.model
     ev = m.edge_vertex
+    x = contact_centres(scene, x, rest)
     if scene.contact is not None and (scene.contact.radius_window > 0.0
                                       or scene.contact.thinning == "rod"):
         lam = scene.contact.section_stretch(x, rest)

@@ -10,6 +10,7 @@ from tightknot.knots.open_measures import lambda_oc
 from tightknot.knots.scenes import (
     KnotScene,
     bending_force_scale,
+    contact_centres,
     end_vertex,
     gauge,
     vertex_radii,
@@ -77,9 +78,11 @@ def knot_kept(scene: KnotScene, types: list[str], rejected: bool,
 
 
 def knot_length(scene: KnotScene, system: RodSystem) -> float:
-    """Lambda_OC of the system's state, with the deformed radii."""
+    """Lambda_OC of the system's state, with the deformed radii, on the sections' centres
+    (:func:`tightknot.knots.scenes.contact_centres`)."""
     x = system.state.x
-    return lambda_oc(x, scene.diameter, vertex_radii(scene, x, system.rest)[1])
+    return lambda_oc(contact_centres(scene, x, system.rest), scene.diameter,
+                     vertex_radii(scene, x, system.rest)[1])
 
 
 def tie_to_lambda(

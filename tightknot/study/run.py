@@ -22,7 +22,7 @@ from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal_overlay import aligned, ideal_report
 from tightknot.knots.measure import analyze_centerline
 from tightknot.knots.open_measures import lambda_oc
-from tightknot.knots.scenes import KnotScene, vertex_radii
+from tightknot.knots.scenes import KnotScene, contact_centres, vertex_radii
 from tightknot.loading.pull import tie_to_lambda
 from tightknot.loading.refine import tie_refined
 from tightknot.loading.tie import TieResult, end_reaction, tie
@@ -110,7 +110,8 @@ def log_state(log: Any, scene: KnotScene, name: str, system: RodSystem,
         where = f"{name}/{phase}" if phase else name
         scalars = {f"{where}/end_to_end": float(np.linalg.norm(x[-1] - x[0])),
                    f"{where}/pulling_force": end_reaction(system)}
-        lam = lambda_oc(x, scene.diameter, r_v, tol=CONTACT_TOL)
+        lam = lambda_oc(contact_centres(scene, x, system.rest), scene.diameter, r_v,
+                        tol=CONTACT_TOL)
         if np.isfinite(lam):
             scalars[f"{where}/lambda_oc"] = lam
         log.log_scalars(scalars)
@@ -121,7 +122,8 @@ def pull_point(scene: KnotScene, system: RodSystem) -> tuple[float, float, float
     the end-to-end distance [m] and Lambda_OC (None without contact)."""
     x = system.state.x
     _, r_v = vertex_radii(scene, x, system.rest)
-    lam = lambda_oc(x, scene.diameter, r_v, tol=CONTACT_TOL)
+    lam = lambda_oc(contact_centres(scene, x, system.rest), scene.diameter, r_v,
+                    tol=CONTACT_TOL)
     return (end_reaction(system), float(np.linalg.norm(x[-1] - x[0])),
             float(lam) if np.isfinite(lam) else None)
 
@@ -345,9 +347,11 @@ def measure_run(scene: KnotScene, res: TieResult, load_steps: int) -> KnotRun:
     _, r_v = vertex_radii(scene, x, res.system.rest)
     # Contact as physics.md sec. 2 defines it for a rod model: distance at most the sum of
     # the deformed radii; the measurement's 1 % tolerance covers the vertex sampling of the
-    # centerline (segments touch between vertices) and the contact law's onset band.
-    rep = analyze_centerline(x, scene.diameter, scene.closed, rest_length=scene.rest_length,
-                             radii=r_v, contact_tol=CONTACT_TOL)
+    # centerline (segments touch between vertices) and the contact law's onset band. The
+    # measured line is the sections' centres (the centreline unless they shift in a bend).
+    rep = analyze_centerline(contact_centres(scene, x, res.system.rest), scene.diameter,
+                             scene.closed, rest_length=scene.rest_length, radii=r_v,
+                             contact_tol=CONTACT_TOL)
     contact = contact_report(scene.contact, x, res.system.rest, res.system.state)
     summary = summarise(scene, res, rep, contact)
     summary["load_steps"] = load_steps
