@@ -308,3 +308,11 @@ def test_analyze_of_a_tied_open_knot_gives_its_lambda_oc(tmp_path) -> None:
     rep = json.loads(rep_json.read_text())
     # Same points (repr floats), same radii up to the round-off of the rest lengths.
     assert rep["Lambda_OC"] == pytest.approx(data["lambda_oc"], abs=1e-9)
+
+
+def test_a_bend_shift_without_the_sectioned_level_exits_2(tmp_path, capsys) -> None:
+    out = tmp_path / "run"
+    assert main(["tie", "closed", "--contact", "compliant", "--section-bend-shift", "on",
+                 "--nodes", "60", "--out", str(out)]) == 2
+    assert "section_bend_shift" in capsys.readouterr().err
+    assert not out.exists()  # refused before anything is written

@@ -240,3 +240,33 @@ def test_knot_measures_read_the_sections_centres() -> None:
     lam = np.linalg.norm(centres[ev[:, 1]] - centres[ev[:, 0]], axis=1) / rest
     r_e, _ = vertex_radii(shifted, x, rest)
     assert np.allclose(r_e, shifted.model.edge_radius * lam ** -0.5, rtol=1e-12)
+
+
+def test_the_largest_bend_is_read_off_the_shift() -> None:
+    # kappa R on a circle of radius 3 D0: 1/6 less the chords' (L / rho)^2 / 24
+    model = _model([_circle(3.0 * D0, 121, True)], True)
+    kr = SectionShift(model).max_kappa_r(model.vertex_initial_position, model.edge_rest_length)
+    assert kr == pytest.approx(1.0 / 6.0, rel=0.01) and kr < 1.0 / 6.0
+
+
+def test_a_bend_tighter_than_the_fem_measured_is_reported() -> None:
+    from tightknot.contact.report import contact_report
+    from tightknot.contact.section_shift import MEASURED_KAPPA_R
+    from tightknot.knots.scenes import closed_trefoil
+    from tightknot.study.run import calibration_range
+
+    for shift in (True, False):
+        scene = closed_trefoil(16.37, nodes=60, contact=SectionSettings(bend_shift=shift))
+        st = scene.state
+        st.extra = np.zeros(scene.contact.dof_count)
+        # the start with its rest lengths shortened to 0.7: its tightest chord bend kappa R
+        # 0.39 / 0.7 = 0.56 (the tied knot's: 0.51 at 60 vertices)
+        rest = 0.7 * scene.model.edge_rest_length
+        rep = contact_report(scene.contact, st.x, rest, st)
+        warnings = calibration_range(scene, rep, st.x, rest)["warnings"]
+        said = [w for w in warnings if "bend shift" in w]
+        if shift:
+            assert scene.contact.shift.max_kappa_r(st.x, rest) > MEASURED_KAPPA_R
+            assert len(said) == 1 and "extrapolated" in said[0]
+        else:
+            assert not said

@@ -33,6 +33,10 @@ import numpy as np
 from tightknot.rods.model import Model
 from tightknot.rods.term import BlockHessian
 
+#: The largest kappa R at which our FEM measured the shift (docs/fem_nip.md, "The relaxed
+#: U": the clasp's U at bend radius 1.25 D0, where it is 0.217 kappa R^2, 13 % below nu/2).
+MEASURED_KAPPA_R = 0.444
+
 #: Shortest chord [D0] the curvature is taken over: the Jacobian's eigenvalues stay at or
 #: above 1 - 2 nu R^2 / s^2 = 0.56 at nu = 1/2 (class docstring).
 MIN_CHORD = 0.75
@@ -65,7 +69,7 @@ class SectionShift:
         self.chord = float(chord)
         keep = (np.ones(len(model.rods), dtype=bool) if rods is None
                 else np.asarray(rods, dtype=bool))
-        prev, mid, nxt, before, after, nu_r2 = [], [], [], [], [], []
+        prev, mid, nxt, before, after, nu_r2, radius = [], [], [], [], [], [], []
         rest0 = np.asarray(model.edge_rest_length, dtype=np.float64)
         for r, rod in enumerate(model.rods):
             if not keep[r] or rod.edge_count < 2:
@@ -90,6 +94,7 @@ class SectionShift:
             before.append(rod.edge_start + (local[:, None] - m + steps[None, :]) % nv)
             after.append(rod.edge_start + (local[:, None] + steps[None, :]) % nv)
             nu_r2.append(np.full(local.size, rod.material.poisson_ratio * (0.5 * d0) ** 2))
+            radius.append(np.full(local.size, 0.5 * d0))
         def cat(parts: list[np.ndarray], shape: tuple[int, ...]) -> np.ndarray:
             return np.concatenate(parts) if parts else np.zeros(shape, dtype=np.int64)
         self._prev = cat(prev, (0,))
@@ -108,13 +113,24 @@ class SectionShift:
             self._after[row:row + n, :w] = a
             self._weight[row:row + n, :w] = 1.0
             row += n
-        #: nu R^2 of each shifting vertex [m^2].
+        #: nu R^2 of each shifting vertex [m^2] and its rest radius R [m].
         self.nu_r2 = np.concatenate(nu_r2) if nu_r2 else np.zeros(0)
+        self.radius = np.concatenate(radius) if radius else np.zeros(0)
 
     @property
     def count(self) -> int:
         """Number of vertices that shift."""
         return int(self._mid.size)
+
+    def max_kappa_r(self, x: np.ndarray, rest: np.ndarray) -> float:
+        """The largest kappa R [-] of the shifting vertices at positions ``x`` [m] and edge
+        rest lengths ``rest`` [m] (the chords' curvature; 0 where none shift)."""
+        if self.count == 0:
+            return 0.0
+        sh = self.at(x, rest)
+        # |s_v| = c |t_1 - t_0| = (nu R^2 / 2) kappa
+        size = sh.c * np.linalg.norm(sh.t1 - sh.t0, axis=1)
+        return float(np.max(2.0 * size * self.radius / self.nu_r2))
 
     def at(self, x: np.ndarray, rest: np.ndarray) -> ShiftedCentreline:
         """The offset centreline at positions ``x`` [m] (V, 3) and edge rest lengths

@@ -287,6 +287,13 @@ class LoadPath:
                               "again there), full (every load step with the sections: a "
                               "pulled knot's equilibrium can depend on its path) or auto "
                               "(final for a closed knot, full for an open one)")
+    # A setting of the sectioned level beside its path, not a scene parameter: sweeps run
+    # without it, so their case ids stay (tightknot/sweep/cases.py, NOT_CASE_KEYS).
+    section_bend_shift: bool = param(False, None, "",
+                                     "at the sectioned contact level, move each section "
+                                     "toward its bend's centre by nu kappa R^2 / 2 "
+                                     "(Saint-Venant's anticlastic shift; off by default: "
+                                     "docs/sectioned_level.md)")
 
 
 #: The loads of an open knot's pull: a run gives exactly one of them.

@@ -263,7 +263,11 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     from tightknot.rods.material import Material
 
     material = Material(values["youngs_modulus"], values["poisson"], values["density"])
-    contact = (SectionSettings(max_mode=values["section_modes"])
+    shift = bool(values.get("section_bend_shift", False))
+    if shift and values["contact"] != "sectioned":
+        raise ValueError(f"section_bend_shift: on needs contact sectioned, got contact "
+                         f"{values['contact']}")
+    contact = (SectionSettings(max_mode=values["section_modes"], bend_shift=shift)
                if values["contact"] == "sectioned" else values["contact"])
     if values.get("start") is not None:
         from tightknot.knots import start_curve

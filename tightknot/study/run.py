@@ -17,6 +17,7 @@ import numpy as np
 from tightknot.contact.checks import deepest_approaches
 from tightknot.contact.layer import ContactLayer
 from tightknot.contact.report import ContactReport, contact_report
+from tightknot.contact.section_shift import MEASURED_KAPPA_R
 from tightknot.contact.sectioned import SectionedLayer
 from tightknot.knots.curvature import bergou_curvature
 from tightknot.knots.ideal_overlay import aligned, ideal_report
@@ -247,7 +248,9 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
     a crossing deeper than the point law's fit, whose core was fitted to line squeezes
     only; a rod that is not incompressible, nu != 0.5, while the law was calibrated on an
     incompressible solid; at the sectioned level, sections thinner than the FEM judged
-    them, :attr:`~tightknot.contact.sectioned.SectionCalibration.judged_area_ratio`)."""
+    them, :attr:`~tightknot.contact.sectioned.SectionCalibration.judged_area_ratio`, and
+    with its bend shift a bend tighter than the FEM measured the shift at,
+    :data:`~tightknot.contact.section_shift.MEASURED_KAPPA_R`)."""
     law = scene.contact.law
     w_hat = 0.5 * float(np.max(contact.overlap, initial=0.0)) / scene.diameter
     warnings = []
@@ -275,6 +278,13 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
             warnings.append(f"the sections' area falls to A/A0 = {area:.3g}, below the "
                             f"{scene.contact.calibration.judged_area_ratio:.3g} at which "
                             "the FEM judged them (a section that thin is extrapolated)")
+        shift = getattr(scene.contact, "shift", None) if sectioned else None
+        if shift is not None and x is not None and rest is not None:
+            kr = shift.max_kappa_r(x, rest)
+            if kr > MEASURED_KAPPA_R:
+                warnings.append(f"the sections' bend shift reaches kappa R = {kr:.3g}, beyond "
+                                f"the {MEASURED_KAPPA_R:.3g} at which the FEM measured it "
+                                "(docs/fem_nip.md; the shift there is extrapolated)")
         nus = {r.material.poisson_ratio for r in scene.model.rods}
         if any(abs(nu - 0.5) > 1e-12 for nu in nus):
             warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "

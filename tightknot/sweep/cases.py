@@ -48,10 +48,11 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
 #: pictures; the device is the sweep's, not the case's; it sweeps the built-in knots from
 #: their parametric starts, not a user's start curve or an ideal start (``tie --start``,
 #: ``--start-shape``); a sectioned case runs tie()'s default path (``section_path``
-#: "auto"), as the open knots' sweep path pulls with the sections.
+#: "auto"), as the open knots' sweep path pulls with the sections; the sections' bend shift
+#: is an opt-in the FEM does not back (docs/sectioned_level.md), so sweeps run without it.
 NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
                  "coarse_nodes", "color_by", "device", "start", "units", "columns",
-                 "start_shape", "section_path")
+                 "start_shape", "section_path", "section_bend_shift")
 #: Level lists of an open knot -> the load each level is (its range and unit).
 LEVELS = {"pull_force": "force", "target_lambda": "target_lambda"}
 LEVEL_KEYS = tuple(LEVELS)
