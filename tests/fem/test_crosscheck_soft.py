@@ -88,3 +88,26 @@ def test_soft_rows_from_one_coarse_level(soft_wrap_one_level, clasp_one_level):
         assert 0.0 < clasp["kinematic_offset"]["clamp_travel_over_d0"] < 0.3
         assert clasp["comparison"]["levels"][0]["rod_force_kinematics_matched"] > 0.0
     assert rows["passed"] == rows["levels"]["compliant"]["passed"]
+
+
+def test_soft_rows_of_the_sectioned_level_with_the_bend_shift(soft_wrap_one_level,
+                                                              clasp_one_level) -> None:
+    # The sectioned cross-check's soft rows (tightknot fem crosscheck --contact sectioned):
+    # that level alone, with its settings. With the shift the rod model's bends reach
+    # where the solid's do: the kinematic offset shrinks from 0.13 to 0.015 D0 of clamp
+    # travel at the medium mesh (docs/sectioned_level.md).
+    from tightknot.contact.sectioned import SectionSettings
+
+    rows = soft_rows("coarse", {"soft_wrap": soft_wrap_one_level, "clasp": clasp_one_level},
+                     section=SectionSettings(bend_shift=True), levels=("sectioned",))
+    json.dumps(rows, allow_nan=False)
+    assert set(rows["levels"]) == {"sectioned"}
+    assert rows["passed"] == rows["levels"]["sectioned"]["passed"]
+    clasp = rows["levels"]["sectioned"]["scenes"]["clasp"]
+    assert abs(clasp["kinematic_offset"]["clamp_travel_over_d0"]) < 0.06
+    for name in ("soft_wrap", "clasp"):
+        row = rows["levels"]["sectioned"]["scenes"][name]["comparison"]["levels"][0]
+        assert row["rod_converged"] and row["rod_force"] > 0.0
+    with pytest.raises(ValueError, match="levels"):
+        soft_rows("coarse", {"soft_wrap": soft_wrap_one_level, "clasp": clasp_one_level},
+                  levels=("rigid",))

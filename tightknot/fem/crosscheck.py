@@ -346,9 +346,10 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     """Run indent and wrap with the FEM (``mesh``) and the rod model at the contact level
     ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N,
     ``bend_shift``: its sections centred on the bend's offset centreline) and
-    compare them; at the compliant level with ``soft``, also the two-soft-rod scenes
-    soft_wrap and clasp (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, its
-    compliant level's ``passed`` part of the report's).
+    compare them; with ``soft``, also the two-soft-rod scenes soft_wrap and clasp
+    (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, at every level of
+    :data:`~tightknot.fem.rod_model_soft.CONTACT_LEVELS` in a compliant report, at the
+    sectioned level in a sectioned one; that level's ``passed`` part of the report's).
 
     ``fem_results`` may hold already computed FEM results (keys "indent", "wrap",
     "soft_wrap", "clasp" and the soft scenes on the spread mesh, "soft_wrap@coarse" ...,
@@ -375,7 +376,21 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         fem_results["wrap"] = run_scene("wrap", mesh=mesh, convergence=False)
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
     if contact == "sectioned":
-        return _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift)
+        report = _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift)
+        if soft:
+            from tightknot.contact.sectioned import SectionSettings
+
+            from .crosscheck_soft import fem_runs, soft_rows
+
+            fem_results = fem_runs(mesh, fem_results)
+            section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift)
+            report["soft_scenes"] = soft_rows(mesh, fem_results, section=section,
+                                              levels=("sectioned",))
+            report["fem_results"].update({k: v for k, v in fem_results.items()
+                                          if k not in ("indent", "wrap")})
+            report["passed"] = report["passed"] and report["soft_scenes"]["passed"]
+            report["wall_time_s"] = time.perf_counter() - start
+        return finite(report)
     warm = _warm_up()
     rod_ind = _rod_indent_like(fem_ind)
     rod_wr = _rod_wrap_like(fem_wrap)
