@@ -86,3 +86,35 @@ def test_scaling_refuses_a_coil_tighter_than_its_rod(capsys):
     assert main(["bench", "scaling", "--sizes", "100", "--helix-radius", "0.5"]) == 2
     err = capsys.readouterr().err
     assert "helix_radius must be >= 0.75" in err and len(err.strip().splitlines()) == 1
+
+
+def _report(contact: str, force: float, **extra) -> dict:
+    """A cross-check report's minimal shape: indent and wrap comparisons, times."""
+    cmp = {"comparison": {"levels": [{"force_rel": force, "area_points": 0.01,
+                                      "curvature_rel": 0.02, "width_fraction": None}]}}
+    scenes = {"indent": cmp, "wrap": cmp}
+    return {"contact": contact, "scenes": scenes, "fem_wall_time_s": 100.0,
+            "rod_wall_time_s": 1.0, "fem_over_rod_time_ratio": 100.0, "passed": False,
+            "mesh": "medium", **extra}
+
+
+def test_tradeoff_truth_table_takes_several_sectioned_reports(tmp_path, capsys):
+    # bench tradeoff --fem XC --fem-sectioned A B: a sectioned row each, the bend shift's
+    # named (the CLI path; the table's values: tests/fem/test_crosscheck.py)
+    xc = _report("compliant", -0.1,
+                 smoothed_contact_level=_report("compliant", -0.05))
+    files = []
+    for name, shift in (("a", False), ("b", True)):
+        path = tmp_path / f"{name}.json"
+        path.write_text(json.dumps(_report("sectioned", 0.03, section_bend_shift=shift)))
+        files.append(str(path))
+    fem = tmp_path / "xc.json"
+    fem.write_text(json.dumps(xc))
+    out = tmp_path / "truth.json"
+    assert main(["bench", "tradeoff", "--fem", str(fem), "--fem-sectioned", *files,
+                 "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "| sectioned |" in text and "| sectioned + bend shift |" in text
+    rows = json.loads(out.read_text())["rows"]
+    assert [r["level"] for r in rows] == ["compliant", "smoothed", "sectioned", "sectioned",
+                                         "rigid"]

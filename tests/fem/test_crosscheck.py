@@ -231,3 +231,18 @@ def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
     assert "| sectioned |" in format_table(level_truth(report, None, sec))
     with pytest.raises(ValueError, match="sectioned level"):
         level_truth(report, None, report)
+    # several sectioned reports, a row each (with and without the bend shift), and the
+    # two-soft-rod scenes' rows where a report carries them
+    soft = {"levels": {"sectioned": {"scenes": {
+        "clasp": {"comparison": {"levels": [{"force_rel": 0.1}, {"force_rel": -0.2}]},
+                  "fem_over_rod_time_ratio": 500.0}}}}}
+    shifted = {**sec, "section_bend_shift": True, "soft_scenes": soft}
+    table = level_truth(report, None, [sec, shifted])
+    both = [r for r in table["rows"] if r["level"] == "sectioned"]
+    assert [r["section_bend_shift"] for r in both] == [False, True]
+    assert both[0]["soft"] is None
+    assert both[1]["soft"] == {"clasp_force_rel": [-0.2, 0.1],
+                               "clasp_fem_over_rod_time_ratio": 500.0}
+    text = format_table(table)
+    assert "| sectioned + bend shift |" in text and "-20.0 .. +10.0 %" in text
+    assert "soft wrap and the clasp at compliant, smoothed, sectioned" in table["not_covered"]

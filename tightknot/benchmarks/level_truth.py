@@ -54,6 +54,20 @@ def _scene_errors(scenes: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+def _soft_errors(report: dict[str, Any], level: str) -> dict[str, Any] | None:
+    """The two-soft-rod scenes' errors of ``level`` in a report's ``soft_scenes`` (the soft
+    wrap's mid line load and the clasp's pull force, min and max over the compared load
+    levels, and the FEM over rod time of each), None where the report has none."""
+    entry = (report.get("soft_scenes") or {}).get("levels", {}).get(level)
+    if entry is None:
+        return None
+    out: dict[str, Any] = {}
+    for name, sc in entry["scenes"].items():
+        out[f"{name}_force_rel"] = _range(sc["comparison"]["levels"], "force_rel")
+        out[f"{name}_fem_over_rod_time_ratio"] = sc["fem_over_rod_time_ratio"]
+    return out
+
+
 def _knot_cost(contact_levels: dict | None, level: str) -> dict[str, Any] | None:
     if contact_levels is None:
         return None
@@ -71,11 +85,13 @@ def _knot_cost(contact_levels: dict | None, level: str) -> dict[str, Any] | None
 
 
 def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None,
-                sectioned: dict[str, Any] | None = None) -> dict[str, Any]:
+                sectioned: dict[str, Any] | list[dict[str, Any]] | None = None
+                ) -> dict[str, Any]:
     """The table (module docstring) from a cross-check report and, optionally, the contact
-    levels' knot benchmark and the sectioned level's cross-check report. Raises ValueError
-    when ``crosscheck`` is not a cross-check report of the compliant level, or
-    ``sectioned`` not one of the sectioned level."""
+    levels' knot benchmark and the sectioned level's cross-check reports (one row each,
+    e.g. with and without its bend shift; the knots' cost goes to a row without the
+    shift, the benchmark's). Raises ValueError when ``crosscheck`` is not a cross-check
+    report of the compliant level, or a ``sectioned`` one not of the sectioned level."""
     if not isinstance(crosscheck, dict) or "scenes" not in crosscheck \
             or "smoothed_contact_level" not in crosscheck:
         raise ValueError("not a cross-check report (tightknot fem crosscheck --json F): it "
@@ -86,30 +102,41 @@ def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None,
         {"level": "compliant", **_scene_errors(crosscheck["scenes"]),
          "rod_wall_time_s": crosscheck["rod_wall_time_s"],
          "fem_over_rod_time_ratio": crosscheck["fem_over_rod_time_ratio"],
-         "passed": crosscheck["passed"], "knots": _knot_cost(contact_levels, "compliant")},
+         "passed": crosscheck["passed"], "knots": _knot_cost(contact_levels, "compliant"),
+         "soft": _soft_errors(crosscheck, "compliant")},
         {"level": "smoothed", **_scene_errors(sm["scenes"]),
          "rod_wall_time_s": sm["rod_wall_time_s"],
          "fem_over_rod_time_ratio": sm["fem_over_rod_time_ratio"],
-         "passed": sm["passed"], "knots": _knot_cost(contact_levels, "smoothed")},
+         "passed": sm["passed"], "knots": _knot_cost(contact_levels, "smoothed"),
+         "soft": _soft_errors(crosscheck, "smoothed")},
     ]
-    if sectioned is not None:
-        if sectioned.get("contact") != "sectioned" or "scenes" not in sectioned:
+    reports = [] if sectioned is None else (
+        [sectioned] if isinstance(sectioned, dict) else list(sectioned))
+    for sec in reports:
+        if sec.get("contact") != "sectioned" or "scenes" not in sec:
             raise ValueError("not a cross-check report of the sectioned level (tightknot fem "
                              "crosscheck --contact sectioned --json F)")
-        rows.append({"level": "sectioned", **_scene_errors(sectioned["scenes"]),
-                     "section_modes": sectioned.get("section_modes"),
-                     "rod_wall_time_s": sectioned["rod_wall_time_s"],
-                     "fem_over_rod_time_ratio": sectioned["fem_over_rod_time_ratio"],
-                     "passed": sectioned["passed"],
-                     "knots": _knot_cost(contact_levels, "sectioned")})
+        shift = bool(sec.get("section_bend_shift", False))
+        rows.append({"level": "sectioned", **_scene_errors(sec["scenes"]),
+                     "section_modes": sec.get("section_modes"),
+                     "rod_wall_time_s": sec["rod_wall_time_s"],
+                     "fem_over_rod_time_ratio": sec["fem_over_rod_time_ratio"],
+                     "section_bend_shift": shift,
+                     "passed": sec["passed"],
+                     "knots": None if shift else _knot_cost(contact_levels, "sectioned"),
+                     "soft": _soft_errors(sec, "sectioned")})
     rows.append({"level": "rigid", "fem_errors": None, "reason": RIGID_REASON,
                  "knots": _knot_cost(contact_levels, "rigid")})
+    missing = [r["level"] for r in rows if r["level"] != "rigid" and r.get("soft") is None]
+    not_covered = ["the FEM's soft_crossing (docs/fem_nip.md)"]
+    if missing:
+        not_covered.append("the soft wrap and the clasp at " + ", ".join(missing)
+                           + " (reports run without --no-soft carry them)")
+    if not reports:
+        not_covered.append("the sectioned level (add --fem-sectioned XCS.json)")
     return {"fem_mesh": crosscheck.get("mesh"), "fem_wall_time_s": fem_time,
             "targets": crosscheck.get("targets"), "rows": rows,
-            "not_covered": "two soft rods (the FEM's soft_crossing, soft_wrap and clasp: "
-                           "docs/fem_nip.md)"
-                           + ("" if sectioned is not None else "; the sectioned level (add "
-                              "--fem-sectioned XCS.json)")}
+            "not_covered": "; ".join(not_covered)}
 
 
 def _pct(r: list[float] | None) -> str:
@@ -120,9 +147,10 @@ def format_table(table: dict[str, Any]) -> str:
     """Markdown table of :func:`level_truth`'s result."""
     lines = [f"contact levels against the FEM ({table['fem_mesh']} mesh, "
              f"{table['fem_wall_time_s']:.0f} s of FEM)",
-             "| level | indent force | wrap line load | area, max [points] | wrap curvature, "
-             "max | L_c, max | rod time [s] | FEM / rod time | knots' time / compliant |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| level | indent force | wrap line load | soft wrap line load | clasp force | "
+             "area, max [points] | wrap curvature, max | L_c, max | rod time [s] | "
+             "FEM / rod time | knots' time / compliant |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in table["rows"]:
         knots = row.get("knots")
         kt = ("n/a" if not knots or knots["time_ratio_to_compliant"] is None else
@@ -130,12 +158,15 @@ def format_table(table: dict[str, Any]) -> str:
               f"{knots['time_ratio_to_compliant'][1]:.2f}")
         if row["level"] == "rigid":
             lines.append(f"| rigid | n/a ({RIGID_REASON}) | n/a | n/a | n/a | n/a | n/a | n/a "
-                         f"| {kt} |")
+                         f"| n/a | n/a | {kt} |")
             continue
         area = max(row["indent_area_points_max"] or 0.0, row["wrap_area_points_max"] or 0.0)
+        soft = row.get("soft") or {}
+        name = row["level"] + (" + bend shift" if row.get("section_bend_shift") else "")
         lines.append(
-            f"| {row['level']} | {_pct(row['indent_force_rel'])} | "
-            f"{_pct(row['wrap_line_load_rel'])} | {100 * area:.1f} | "
+            f"| {name} | {_pct(row['indent_force_rel'])} | "
+            f"{_pct(row['wrap_line_load_rel'])} | {_pct(soft.get('soft_wrap_force_rel'))} | "
+            f"{_pct(soft.get('clasp_force_rel'))} | {100 * area:.1f} | "
             f"{100 * (row['wrap_curvature_rel_max'] or 0.0):.1f} % | "
             + ("n/a" if row["width_fraction_max"] is None
                else f"{row['width_fraction_max']:.2f}")

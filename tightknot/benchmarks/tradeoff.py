@@ -334,9 +334,10 @@ def register(subparsers) -> None:  # noqa: ANN001 (argparse's private subparsers
     p.add_argument("--fem", metavar="XC.json",
                    help="instead of the sweep: each contact level against the FEM, read from "
                    "a cross-check report (tightknot fem crosscheck --json XC.json)")
-    p.add_argument("--fem-sectioned", metavar="XCS.json",
-                   help="with --fem: the sectioned level's cross-check report (tightknot fem "
-                   "crosscheck --contact sectioned --json XCS.json)")
+    p.add_argument("--fem-sectioned", metavar="XCS.json", nargs="+",
+                   help="with --fem: the sectioned level's cross-check reports (tightknot fem "
+                   "crosscheck --contact sectioned [--section-bend-shift] --json XCS.json), "
+                   "a row each")
     p.add_argument("--levels-json", metavar="CL.json",
                    help="with --fem: the knots' cost per level (bench/contact_levels.py "
                    "--json CL.json)")
@@ -373,7 +374,7 @@ def _command(args) -> int:  # noqa: ANN001
 
 
 def _truth_command(fem: str, levels_json: str | None, out: Path | None,
-                   sectioned: str | None = None) -> int:
+                   sectioned: list[str] | None = None) -> int:
     """``bench tradeoff --fem XC.json``: the contact levels against the FEM."""
     import json
 
@@ -388,7 +389,8 @@ def _truth_command(fem: str, levels_json: str | None, out: Path | None,
 
     table = level_truth(read(fem, "--fem"),
                         read(levels_json, "--levels-json") if levels_json else None,
-                        read(sectioned, "--fem-sectioned") if sectioned else None)
+                        [read(f, "--fem-sectioned") for f in sectioned] if sectioned
+                        else None)
     print(format_table(table))
     if out is not None:
         write_json_atomic(out, table)
