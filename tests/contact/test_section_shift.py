@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from tightknot.contact.section_shift import SectionShift
+from tightknot.contact.section_shift import MIN_CHORD, SectionShift
 from tightknot.contact.sectioned import SectionedLayer, SectionSettings
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
@@ -36,11 +36,11 @@ def _circle(rho: float, n: int, closed: bool) -> np.ndarray:
 def test_a_circle_shifts_its_sections_toward_its_centre(closed: bool) -> None:
     # On a circle of radius rho the shift is nu R^2 kappa / 2 toward the centre, kappa
     # the chords' curvature 2 sin(L / 2 rho) / L over arcs L of m edges (1 / rho less
-    # (L / rho)^2 / 24 of it, 0.5 % here); vertices within a chord of an open rod's ends
-    # stay.
+    # (L / rho)^2 / 24 of it, 0.5 % here); an open rod's vertices closer than MIN_CHORD
+    # to an end stay, those within a chord of it take the chord to the end.
     rho = 3.0 * D0
     model = _model([_circle(rho, 121, closed)], closed)
-    shift = SectionShift(model)
+    shift = SectionShift(model, chord=1.0)
     x = model.vertex_initial_position
     out = shift.at(x, model.edge_rest_length).x
     moved = out - x
@@ -57,7 +57,11 @@ def test_a_circle_shifts_its_sections_toward_its_centre(closed: bool) -> None:
     assert np.max(np.abs(moved[inner] + radial[inner, None] * x[inner]
                          / np.linalg.norm(x[inner], axis=1)[:, None])) < 1e-12 * rho
     if not closed:
-        assert np.all(moved[:m] == 0.0) and np.all(moved[-m:] == 0.0)
+        least = math.ceil(MIN_CHORD * D0 / h)
+        assert np.all(moved[:least] == 0.0) and np.all(moved[-least:] == 0.0)
+        assert np.all(radial[least:m] > 0.0) and np.all(radial[-m:-least] > 0.0)
+        # a shorter chord on one side still reads the circle's curvature (to 1 %)
+        assert np.allclose(radial[least:m], expect, rtol=0.01)
 
 
 def test_a_straight_rod_does_not_shift() -> None:
@@ -199,13 +203,16 @@ def test_bad_shift_settings_name_the_option(kwargs: dict, word: str) -> None:
         SectionSettings(**kwargs)
 
 
-def test_a_longer_chord_reaches_further_and_shifts_fewer_end_vertices() -> None:
+def test_the_chord_length_reads_the_same_circle() -> None:
+    # on a circle every chord length gives nearly its curvature, the same vertices shifting
     model = _model([_circle(3.0 * D0, 121, False)])
     x, rest = model.vertex_initial_position, model.edge_rest_length
     one, two = SectionShift(model, chord=1.0), SectionShift(model, chord=2.0)
-    assert two.count < one.count
+    assert two.count == one.count
     moved = np.linalg.norm(two.at(x, rest).x - x, axis=1)
     assert np.count_nonzero(moved) == two.count
+    expect = 0.5 * 0.5 * (0.5 * D0) ** 2 / (3.0 * D0)
+    assert np.allclose(moved[moved > 0], expect, rtol=0.02)
 
 
 def test_knot_measures_read_the_sections_centres() -> None:
@@ -231,7 +238,8 @@ def test_knot_measures_read_the_sections_centres() -> None:
 def test_the_largest_bend_is_read_off_the_shift() -> None:
     # kappa R on a circle of radius 3 D0: 1/6 less the chords' (L / rho)^2 / 24
     model = _model([_circle(3.0 * D0, 121, True)], True)
-    kr = SectionShift(model).max_kappa_r(model.vertex_initial_position, model.edge_rest_length)
+    kr = SectionShift(model, chord=1.0).max_kappa_r(model.vertex_initial_position,
+                                                    model.edge_rest_length)
     assert kr == pytest.approx(1.0 / 6.0, rel=0.01) and kr < 1.0 / 6.0
 
 

@@ -94,8 +94,8 @@ def test_soft_rows_of_the_sectioned_level_with_the_bend_shift(soft_wrap_one_leve
                                                               clasp_one_level) -> None:
     # The sectioned cross-check's soft rows (tightknot fem crosscheck --contact sectioned):
     # that level alone, with its settings. With the shift the rod model's bends reach
-    # where the solid's do: the kinematic offset shrinks from 0.13 to 0.015 D0 of clamp
-    # travel at the medium mesh (docs/sectioned_level.md).
+    # where the solid's do: the kinematic offset shrinks from 0.13 to 0.033 D0 of clamp
+    # travel at the medium mesh (chord 2 D0, docs/sectioned_level.md).
     from tightknot.contact.sectioned import SectionSettings
 
     rows = soft_rows("coarse", {"soft_wrap": soft_wrap_one_level, "clasp": clasp_one_level},

@@ -50,8 +50,10 @@ class SectionShift:
     then I + (nu R^2 / 2) times a second difference over a chord s, whose eigenvalues lie
     in [1 - 2 nu R^2 / s^2, 1] (0.75 at s = D0, nu = 1/2). Over single edges shorter than
     R it would turn the zigzag mode over (a centreline zigzag moving the boundary the other
-    way), so that a contact could be relieved by a zigzag. Vertices of an open rod within
-    a chord of its ends do not shift.
+    way), so that a contact could be relieved by a zigzag. Near an open rod's end the chord
+    stops at the end vertex; vertices closer to an end than :data:`MIN_CHORD` do not
+    shift (a shift that switched on a whole chord from the end would switch on inside a
+    short rod's contact).
 
     Args:
         model: the rods.
@@ -59,7 +61,7 @@ class SectionShift:
         chord: the chords' least length over D0 (>= :data:`MIN_CHORD`).
     """
 
-    def __init__(self, model: Model, rods: np.ndarray | None = None, chord: float = 1.0
+    def __init__(self, model: Model, rods: np.ndarray | None = None, chord: float = 2.0
                  ) -> None:
         if not (math.isfinite(chord) and chord >= MIN_CHORD):
             raise ValueError(f"section bend_shift_chord must be >= {MIN_CHORD} D0 (shorter "
@@ -69,50 +71,62 @@ class SectionShift:
         self.chord = float(chord)
         keep = (np.ones(len(model.rods), dtype=bool) if rods is None
                 else np.asarray(rods, dtype=bool))
-        prev, mid, nxt, before, after, nu_r2, radius = [], [], [], [], [], [], []
+        mids, counts, nu_r2, radius = [], [], [], []
         rest0 = np.asarray(model.edge_rest_length, dtype=np.float64)
         for r, rod in enumerate(model.rods):
             if not keep[r] or rod.edge_count < 2:
                 continue
             edges = np.arange(rod.edge_start, rod.edge_start + rod.edge_count)
             d0 = float(rod.diameter)
-            m = max(1, int(math.ceil(chord * d0 / float(np.median(rest0[edges])) - 1e-9)))
+            h = float(np.median(rest0[edges]))
+            m = max(1, int(math.ceil(chord * d0 / h - 1e-9)))
             nv = rod.vertex_count
             if rod.closed:
                 if 2 * m >= nv:
                     continue
                 local = np.arange(nv)
+                before = after = np.full(nv, m)
             else:
-                local = np.arange(m, nv - m)
+                # near an end the chord stops at the end vertex, but spans at least
+                # MIN_CHORD: vertices closer to an end than that do not shift
+                least = max(1, int(math.ceil(MIN_CHORD * d0 / h - 1e-9)))
+                local = np.arange(least, nv - least)
+                before = np.minimum(m, local)
+                after = np.minimum(m, nv - 1 - local)
             if local.size == 0:
                 continue
-            steps = np.arange(m)
-            # edge j joins local vertices j and j + 1 (mod nv on a closed rod)
-            prev.append(rod.vertex_start + (local - m) % nv)
-            mid.append(rod.vertex_start + local)
-            nxt.append(rod.vertex_start + (local + m) % nv)
-            before.append(rod.edge_start + (local[:, None] - m + steps[None, :]) % nv)
-            after.append(rod.edge_start + (local[:, None] + steps[None, :]) % nv)
+            mids.append((rod, local))
+            counts.append((before, after))
             nu_r2.append(np.full(local.size, rod.material.poisson_ratio * (0.5 * d0) ** 2))
             radius.append(np.full(local.size, 0.5 * d0))
-        def cat(parts: list[np.ndarray], shape: tuple[int, ...]) -> np.ndarray:
-            return np.concatenate(parts) if parts else np.zeros(shape, dtype=np.int64)
-        self._prev = cat(prev, (0,))
-        self._mid = cat(mid, (0,))
-        self._next = cat(nxt, (0,))
-        # the chords' edges; rods of different chord lengths padded with a repeated edge
-        # weighted zero
-        width = max((b.shape[1] for b in before), default=1)
-        self._before = np.zeros((self._mid.size, width), dtype=np.int64)
-        self._after = np.zeros((self._mid.size, width), dtype=np.int64)
-        self._weight = np.zeros((self._mid.size, width))
+        total = sum(loc.size for _, loc in mids)
+        width = max((int(max(bf.max(), af.max())) for bf, af in counts), default=1)
+        self._prev = np.zeros(total, dtype=np.int64)
+        self._mid = np.zeros(total, dtype=np.int64)
+        self._next = np.zeros(total, dtype=np.int64)
+        # each vertex's chords' edges, padded to one width with edges weighted zero
+        self._before = np.zeros((total, width), dtype=np.int64)
+        self._after = np.zeros((total, width), dtype=np.int64)
+        self._weight_before = np.zeros((total, width))
+        self._weight_after = np.zeros((total, width))
         row = 0
-        for b, a in zip(before, after, strict=True):
-            n, w = b.shape
-            self._before[row:row + n, :w] = b
-            self._after[row:row + n, :w] = a
-            self._weight[row:row + n, :w] = 1.0
-            row += n
+        steps = np.arange(width)
+        for (rod, local), (bf, af) in zip(mids, counts, strict=True):
+            nv = rod.vertex_count
+            rows = slice(row, row + local.size)
+            # edge j joins local vertices j and j + 1 (mod nv on a closed rod)
+            self._prev[rows] = rod.vertex_start + (local - bf) % nv
+            self._mid[rows] = rod.vertex_start + local
+            self._next[rows] = rod.vertex_start + (local + af) % nv
+            in_b = steps[None, :] < bf[:, None]
+            in_a = steps[None, :] < af[:, None]
+            self._before[rows] = rod.edge_start + np.where(
+                in_b, (local[:, None] - bf[:, None] + steps[None, :]) % nv, 0)
+            self._after[rows] = rod.edge_start + np.where(
+                in_a, (local[:, None] + steps[None, :]) % nv, 0)
+            self._weight_before[rows] = in_b
+            self._weight_after[rows] = in_a
+            row += local.size
         #: nu R^2 of each shifting vertex [m^2] and its rest radius R [m].
         self.nu_r2 = np.concatenate(nu_r2) if nu_r2 else np.zeros(0)
         self.radius = np.concatenate(radius) if radius else np.zeros(0)
@@ -145,7 +159,8 @@ class SectionShift:
         t1 = e1 / l1[:, None]
         # s_v = (nu R^2 / 2) kappa_v = nu R^2 (t_1 - t_0) / (L0_bar + L1_bar), the chords'
         # rest lengths L_bar
-        arc = np.sum((rest[self._before] + rest[self._after]) * self._weight, axis=1)
+        arc = (np.sum(rest[self._before] * self._weight_before, axis=1)
+               + np.sum(rest[self._after] * self._weight_after, axis=1))
         c = self.nu_r2 / arc
         shifted = x.copy()
         shifted[self._mid] += c[:, None] * (t1 - t0)

@@ -138,10 +138,12 @@ class SectionSettings:
         bend_shift: centre each section's boundary on the tight bend's offset centreline,
             x + (nu R^2 / 2) kappa (Saint-Venant's anticlastic flexure,
             :mod:`tightknot.contact.section_shift`); False (the default): on the
-            centreline. Off by default: it brings the clasp's first contact to the FEM's
-            but moves the wraps away from it (docs/sectioned_level.md, "The bend's section
-            shift").
-        bend_shift_chord: the least chord [D0] the shift's curvature is taken over.
+            centreline. Off by default: it meets the FEM's clasp from 0.67 D0 of clamp
+            travel on, but costs time and moves the rigid wrap's second tension off the
+            target (docs/sectioned_level.md, "The bend's section shift").
+        bend_shift_chord: the chord [D0] the shift's curvature is taken over, each side
+            (2 D0: of the chords tried, the one the FEM's clasp and wraps agree with best,
+            docs/sectioned_level.md; at least 0.75).
     """
 
     max_mode: int = 8
@@ -149,7 +151,7 @@ class SectionSettings:
     penalty: float | None = None
     onset: float = 1e-4
     bend_shift: bool = False
-    bend_shift_chord: float = 1.0
+    bend_shift_chord: float = 2.0
 
     def __post_init__(self) -> None:
         if (isinstance(self.max_mode, bool) or int(self.max_mode) != self.max_mode
