@@ -3,7 +3,9 @@
 ratios, not seconds: the machines are shared).
 
 Usage: ``python bench/contact_levels.py [--closed-nodes 100] [--open-nodes 150]
-[--levels compliant smoothed] [--section-path auto] [--json out.json]``.
+[--levels compliant smoothed] [--section-path auto] [--json out.json]``. The level
+``sectioned-shift`` is the sectioned level with its bend shift
+(``SectionSettings(bend_shift=True)``, docs/sectioned_level.md).
 """
 
 from __future__ import annotations
@@ -15,8 +17,14 @@ import time
 import numpy as np
 
 from tightknot.atomic import write_json_atomic
+from tightknot.contact.sectioned import SectionSettings
 from tightknot.knots.open_measures import lambda_oc
-from tightknot.knots.scenes import closed_trefoil, open_trefoil, vertex_radii
+from tightknot.knots.scenes import (
+    closed_trefoil,
+    contact_centres,
+    open_trefoil,
+    vertex_radii,
+)
 from tightknot.loading.pull import tie_to_lambda
 from tightknot.loading.tie import tie
 
@@ -24,10 +32,15 @@ from tightknot.loading.tie import tie
 OPEN_CASES = (("open_125mm_to_10.1", 0.125, 10.1), ("open_185mm_to_15", 0.185, 15.0))
 
 
+def _contact(level: str) -> str | SectionSettings:
+    """The scenes' contact of a benchmark level."""
+    return SectionSettings(bend_shift=True) if level == "sectioned-shift" else level
+
+
 def closed_case(level: str, nodes: int, section_path: str = "auto") -> dict:
     """The closed trefoil at L0/D0 = 16.37 (``section_path``: the sectioned level's load
     path, :func:`tightknot.loading.tie.path_scene`)."""
-    scene = closed_trefoil(16.37, nodes=nodes, contact=level)
+    scene = closed_trefoil(16.37, nodes=nodes, contact=_contact(level))
     t0 = time.perf_counter()
     res = tie(scene, tighten_steps=20, section_path=section_path).run()
     wall = time.perf_counter() - t0
@@ -43,12 +56,13 @@ def closed_case(level: str, nodes: int, section_path: str = "auto") -> dict:
 def open_case(level: str, nodes: int, name: str, length: float, target: float,
               section_path: str = "auto") -> dict:
     """An open trefoil of rest ``length`` [m] pulled to Lambda_OC ``target``."""
-    scene = open_trefoil(length, nodes=nodes, contact=level)
+    scene = open_trefoil(length, nodes=nodes, contact=_contact(level))
     t0 = time.perf_counter()
     res = tie_to_lambda(scene, target, section_path=section_path).run()
     wall = time.perf_counter() - t0
     x = res.system.state.x
-    lam = lambda_oc(x, scene.diameter, vertex_radii(scene, x, res.system.rest)[1])
+    lam = lambda_oc(contact_centres(scene, x, res.system.rest), scene.diameter,
+                    vertex_radii(scene, x, res.system.rest)[1])
     return {"case": name, "level": level, "vertices": nodes, "section_path": section_path,
             "converged": res.converged,
             "failure": res.failure, "knot_types": sorted(set(res.knot_types)),
@@ -61,7 +75,8 @@ def main() -> None:
     parser.add_argument("--closed-nodes", type=int, default=100)
     parser.add_argument("--open-nodes", type=int, default=150)
     parser.add_argument("--levels", nargs="+", default=["compliant", "smoothed"],
-                        choices=["compliant", "smoothed", "sectioned", "rigid"])
+                        choices=["compliant", "smoothed", "sectioned", "sectioned-shift",
+                                 "rigid"])
     parser.add_argument("--section-path", default="auto", choices=["auto", "final", "full"],
                         help="the sectioned level's load path (tightknot.loading.tie.path_scene)")
     parser.add_argument("--json", default=None)

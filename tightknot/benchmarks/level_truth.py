@@ -89,9 +89,10 @@ def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None,
                 ) -> dict[str, Any]:
     """The table (module docstring) from a cross-check report and, optionally, the contact
     levels' knot benchmark and the sectioned level's cross-check reports (one row each,
-    e.g. with and without its bend shift; the knots' cost goes to a row without the
-    shift, the benchmark's). Raises ValueError when ``crosscheck`` is not a cross-check
-    report of the compliant level, or a ``sectioned`` one not of the sectioned level."""
+    e.g. with and without its bend shift; the benchmark's level "sectioned-shift" gives
+    the knots' cost of the shifted row). Raises ValueError when ``crosscheck`` is not a
+    cross-check report of the compliant level, or a ``sectioned`` one not of the sectioned
+    level."""
     if not isinstance(crosscheck, dict) or "scenes" not in crosscheck \
             or "smoothed_contact_level" not in crosscheck:
         raise ValueError("not a cross-check report (tightknot fem crosscheck --json F): it "
@@ -123,7 +124,8 @@ def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None,
                      "fem_over_rod_time_ratio": sec["fem_over_rod_time_ratio"],
                      "section_bend_shift": shift,
                      "passed": sec["passed"],
-                     "knots": None if shift else _knot_cost(contact_levels, "sectioned"),
+                     "knots": _knot_cost(contact_levels,
+                                         "sectioned-shift" if shift else "sectioned"),
                      "soft": _soft_errors(sec, "sectioned")})
     rows.append({"level": "rigid", "fem_errors": None, "reason": RIGID_REASON,
                  "knots": _knot_cost(contact_levels, "rigid")})
