@@ -202,13 +202,7 @@ def _relaxed_u(x_all: np.ndarray, idx_a: np.ndarray, ref: np.ndarray, s_nodes: n
     from tightknot.knots.curvature import bergou_curvature
 
     xa = x_all[idx_a]
-
-    def node(a: float, b: float, j: int) -> np.ndarray:
-        hit = np.flatnonzero(np.isclose(ref[:, 0], a, atol=1e-9 * radius)
-                             & np.isclose(ref[:, 1], b, atol=1e-9 * radius)
-                             & np.isclose(ref[:, 2], s_nodes[j], atol=1e-9 * radius))
-        return xa[hit[0]]
-
+    node = _node_lookup(xa, ref, s_nodes, radius)
     last = len(s_nodes) - 1
     mid = np.array([node(0.0, 0.0, j) for j in range(3)]) * np.array([1.0, 1.0, 0.0])
     mirror = mid[1:][::-1] * np.array([1.0, -1.0, 1.0])
@@ -223,9 +217,30 @@ def _relaxed_u(x_all: np.ndarray, idx_a: np.ndarray, ref: np.ndarray, s_nodes: n
         / (youngs_modulus * math.pi * radius**2),
         "apex_mid_fibre_stretch": float(np.linalg.norm(mid[1] - mid[0]) / s_nodes[1]),
         "apex_kappa_d0": kappa * d0,
-        "inner_offset_over_r": float(mid[0, 0] - node(0.0, radius, 0)[0]) / radius,
-        "outer_offset_over_r": float(node(0.0, -radius, 0)[0] - mid[0, 0]) / radius,
+        **_apex_offsets(node, radius),
     }
+
+
+def _node_lookup(xa: np.ndarray, ref: np.ndarray, s_nodes: np.ndarray, radius: float) -> Any:
+    """The current position of rod A's node at reference section point (a, b) of node layer
+    j, from A's positions ``xa`` [m] and reference points ``ref`` [m]."""
+
+    def node(a: float, b: float, j: int) -> np.ndarray:
+        hit = np.flatnonzero(np.isclose(ref[:, 0], a, atol=1e-9 * radius)
+                             & np.isclose(ref[:, 1], b, atol=1e-9 * radius)
+                             & np.isclose(ref[:, 2], s_nodes[j], atol=1e-9 * radius))
+        return xa[hit[0]]
+
+    return node
+
+
+def _apex_offsets(node: Any, radius: float) -> dict[str, float]:
+    """The apex section's inner (toward the bend's centre) and outer surface points from its
+    mid fibre along x, over R: 1 each for a round section that keeps its size and place; the
+    anticlastic shift makes the inner one larger and the outer one smaller."""
+    mid = node(0.0, 0.0, 0)[0]
+    return {"inner_offset_over_r": float(mid - node(0.0, radius, 0)[0]) / radius,
+            "outer_offset_over_r": float(node(0.0, -radius, 0)[0] - mid) / radius}
 
 
 def rotate_to_b(x: np.ndarray) -> np.ndarray:
@@ -377,6 +392,9 @@ def _run_one(level: str, max_pull_over_d0: float, steps: int, bend_radius_over_d
             "approach_nominal_over_d0": (diameter - d_nominal) / diameter,
             "axial_stretch_apex": stretch,
             "kappa_d0_apex": kappa * diameter,
+            # the apex's surface from its mid fibre (the relaxed U's measure); the inner
+            # side is the contact's, so its offset includes the flattening
+            **_apex_offsets(_node_lookup(xa, ref, s_nodes, radius), radius),
             "area_ratio_apex": prof_a[0]["area_ratio"],
             "area_ratio_apex_b": prof_b[0]["area_ratio"],
             "area_ratio_min": min(row["area_ratio"] for row in prof_a),
