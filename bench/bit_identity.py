@@ -10,7 +10,8 @@ load steps, failed attempts and proximal steps included, in the order they were 
 
 A fourth case, ``lambda``, pulls a 101-vertex 125 mm knot to Lambda_OC 10.1 (the force search
 with its bracketing); ``smoothed`` ties the 60-vertex closed trefoil at the smoothed contact
-level (the kernel's given-radius path). Both run with ``--all``.
+level (the kernel's given-radius path); ``sectioned`` ties it at the sectioned level (its
+section coefficients recorded too). The three run with ``--all``.
 
 Usage::
 
@@ -86,6 +87,11 @@ def _case_smoothed():
     return _case_closed("smoothed")
 
 
+def _case_sectioned():
+    res, arrays = _case_closed("sectioned")
+    return res, [*arrays, res.system.state.extra]
+
+
 def _case_batch():
     from tightknot.knots.scenes import closed_trefoil
     try:
@@ -109,7 +115,7 @@ def _case_lambda():
 
 
 CASES = {"open": _case_open, "closed": _case_closed, "batch": _case_batch,
-         "lambda": _case_lambda, "smoothed": _case_smoothed}
+         "lambda": _case_lambda, "smoothed": _case_smoothed, "sectioned": _case_sectioned}
 DEFAULT = ("open", "closed", "batch")
 
 
@@ -157,7 +163,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, help="write the records here (JSON)")
     ap.add_argument("--compare", help="a record file of the same cases to compare with")
-    ap.add_argument("--all", action="store_true", help="also the lambda and smoothed cases")
+    ap.add_argument("--all", action="store_true",
+                    help="also the lambda, smoothed and sectioned cases")
     ap.add_argument("--case", action="append", choices=list(CASES), help="only this case")
     args = ap.parse_args(argv)
     names = args.case or (list(CASES) if args.all else list(DEFAULT))
