@@ -30,6 +30,14 @@ DENSITY: float = 1160.0
 """Density [kg/m^3] of the rod model's material (statics: it plays no role)."""
 
 
+
+def check_edges_per_d0(edges_per_d0: object) -> None:
+    """Refuse a rod resolution that is not an integer of at least 4 edges per D0 (fewer
+    cannot follow a crossing's dent, about a diameter long)."""
+    if (isinstance(edges_per_d0, bool) or not isinstance(edges_per_d0, (int, np.integer))
+            or edges_per_d0 < 4):
+        raise ValueError(f"edges_per_d0 must be an integer >= 4, got {edges_per_d0!r}")
+
 def rigid_counterbody_law(law: Any) -> Any:
     """The pair law of a rod against a rigid body of the same diameter: k 2^p for the line
     and point laws, so that the kernel's f(delta/2) becomes the per-side f(w = delta)."""
@@ -67,10 +75,11 @@ def _vertices(model: Any, rod: int, edges: int) -> np.ndarray:
 
 
 def indent_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
-                 poisson_ratio: float = 0.5) -> RodScene:
+                 poisson_ratio: float = 0.5, edges_per_d0: int = EDGES_PER_D0) -> RodScene:
     """The indent scene's rods and constraints: a straight rod (axis e_z, Poisson ratio
     ``poisson_ratio``) between two pinned rods along e_x, touching it at rest, that move
-    toward its axis by the level load w [m] each (``obs_v``: the upper one's vertices)."""
+    toward its axis by the level load w [m] each (``obs_v``: the upper one's vertices);
+    ``edges_per_d0`` edges per D0 of rod, on every rod."""
     from tightknot.loading.levels import LevelLoad
     from tightknot.rods.boundary import BoundaryConditions
     from tightknot.rods.builder import RodBuilder
@@ -78,10 +87,11 @@ def indent_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
     from tightknot.rods.state import State
     from tightknot.solvers.system import RodSystem
 
+    check_edges_per_d0(edges_per_d0)
     d0 = diameter
-    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod = int(round(length_over_d0 * edges_per_d0))
     n_rod += n_rod % 2  # even: a vertex at z = 0
-    n_obs = 4 * EDGES_PER_D0
+    n_obs = 4 * edges_per_d0
     half = 0.5 * length_over_d0 * d0
     mat = Material(youngs_modulus, 0.5, DENSITY)
     b = RodBuilder(twist=False)
@@ -114,10 +124,11 @@ WRAP_START_OVERLAP: float = 0.01
 
 
 def wrap_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
-               wrap_angle_deg: float) -> RodScene:
+               wrap_angle_deg: float, edges_per_d0: int = EDGES_PER_D0) -> RodScene:
     """The wrap scene's rods and constraints: a rod (axis e_z at rest) pulled by dead end
     forces, the level load T [N] times (0, sin(theta), +-cos(theta)), around a pinned rod
-    along e_x above it at y = D0 - ``WRAP_START_OVERLAP`` D0 (:func:`wrap_constraints`)."""
+    along e_x above it at y = D0 - ``WRAP_START_OVERLAP`` D0 (:func:`wrap_constraints`);
+    ``edges_per_d0`` edges per D0 of rod, on both rods."""
     from tightknot.loading.levels import LevelLoad
     from tightknot.rods.boundary import BoundaryConditions
     from tightknot.rods.builder import RodBuilder
@@ -125,11 +136,12 @@ def wrap_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
     from tightknot.rods.state import State
     from tightknot.solvers.system import RodSystem
 
+    check_edges_per_d0(edges_per_d0)
     d0 = diameter
     theta = 0.5 * math.radians(wrap_angle_deg)
-    n_rod = int(round(length_over_d0 * EDGES_PER_D0))
+    n_rod = int(round(length_over_d0 * edges_per_d0))
     n_rod += n_rod % 2
-    n_obs = 4 * EDGES_PER_D0
+    n_obs = 4 * edges_per_d0
     half = 0.5 * length_over_d0 * d0
     y_obs = d0 - WRAP_START_OVERLAP * d0
     mat = Material(youngs_modulus, 0.5, DENSITY)

@@ -23,13 +23,17 @@ from typing import Any
 import numpy as np
 
 from .material import ROD_DIAMETER, YOUNGS_MODULUS
-from .rod_model import WRAP_START_OVERLAP, _solve_levels, indent_scene, wrap_scene
+from .rod_model import EDGES_PER_D0, WRAP_START_OVERLAP, _solve_levels, indent_scene, wrap_scene
+
+#: Half-width [D0] of the window the wrap's windowed mid line load sums over.
+WINDOW: float = 0.25
 
 
-def _layer(model: Any, section: Any, rigid_rods: tuple[int, ...]) -> Any:
+def _layer(model: Any, section: Any, rigid_rods: tuple[int, ...], gauss_points: int = 2
+           ) -> Any:
     from tightknot.contact.sectioned import SectionedLayer
 
-    return SectionedLayer(model, section, rigid_rods=rigid_rods, gauss_points=2)
+    return SectionedLayer(model, section, rigid_rods=rigid_rods, gauss_points=gauss_points)
 
 
 def _report(layer: Any, system: Any) -> dict[str, np.ndarray]:
@@ -39,17 +43,20 @@ def _report(layer: Any, system: Any) -> dict[str, np.ndarray]:
 
 def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
                          youngs_modulus: float = YOUNGS_MODULUS, length_over_d0: float = 3.0,
-                         section: Any = None) -> dict[str, Any]:
+                         section: Any = None, edges_per_d0: int = EDGES_PER_D0,
+                         gauss_points: int = 2) -> dict[str, Any]:
     """The indent scene (:func:`tightknot.fem.rod_model.rod_indent`) at the sectioned
-    level (``section``: its :class:`~tightknot.contact.sectioned.SectionSettings`). Per
+    level (``section``: its :class:`~tightknot.contact.sectioned.SectionSettings`;
+    ``edges_per_d0`` and ``gauss_points`` per edge: the rod's resolution). Per
     level: ``force`` [N] on the upper indenter, ``area_ratio_mid``, ``peak_pressure_over_e``,
     ``contact_width_fraction_mid`` (both indenters' contacts), ``axial_stretch_mid``."""
     start = time.perf_counter()
     d0 = diameter
-    scene = indent_scene(diameter, youngs_modulus, length_over_d0)
+    scene = indent_scene(diameter, youngs_modulus, length_over_d0,
+                         edges_per_d0=edges_per_d0)
     system, load, model = scene.system, scene.load, scene.model
     n_rod, mid, half = scene.n_rod, scene.mid, scene.half
-    layer = _layer(model, section, (1, 2))
+    layer = _layer(model, section, (1, 2), gauss_points)
     system.add_term(layer)
     up_v = scene.obs_v
     rod_v0 = model.rods[0].vertex_start
@@ -139,21 +146,30 @@ def _centroid_axis(layer: Any, system: Any, verts: np.ndarray) -> np.ndarray:
 
 def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0,
                        diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
-                       length_over_d0: float = 4.5, section: Any = None) -> dict[str, Any]:
-    """The wrap scene (:func:`tightknot.fem.rod_model.rod_wrap`) at the sectioned level.
+                       length_over_d0: float = 4.5, section: Any = None,
+                       edges_per_d0: int = EDGES_PER_D0, gauss_points: int = 2
+                       ) -> dict[str, Any]:
+    """The wrap scene (:func:`tightknot.fem.rod_model.rod_wrap`) at the sectioned level
+    (``edges_per_d0``, ``gauss_points``: the resolution, as for the indent).
     Per tension level [N]: ``force_per_length_mid`` [N/m] (contact line load at the middle
     per length of the nominal axis), ``kappa_d0_mid`` (its curvature),
     ``approach_over_d0`` (of the nominal axis), ``area_ratio_mid``,
-    ``peak_pressure_over_e``, ``contact_width_fraction_mid``, ``contact_force_total``."""
+    ``peak_pressure_over_e``, ``contact_width_fraction_mid``, ``contact_force_total``;
+    ``force_per_length_mid_window_over_e_d0`` (the vertices' contact forces across the
+    centreline summed as vectors over +-``WINDOW`` D0 of the middle, per stretched
+    length) and
+    ``contact_axial_over_across_mid`` (within +-0.5 D0: the largest axial part of a
+    vertex's contact force over the largest part across; 0 for a frictionless contact)."""
     from tightknot.knots.curvature import bergou_curvature
 
     start = time.perf_counter()
     d0 = diameter
-    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg)
+    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg,
+                       edges_per_d0=edges_per_d0)
     system, load, model = scene.system, scene.load, scene.model
     n_rod, mid, half = scene.n_rod, scene.mid, scene.half
     y_obs = d0 - WRAP_START_OVERLAP * d0
-    layer = _layer(model, section, (1,))
+    layer = _layer(model, section, (1,), gauss_points)
     system.add_term(layer)
     rod_v, obs_v = scene.rod_v, scene.obs_v
 
@@ -181,6 +197,26 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
         kappa_cent = float(bergou_curvature(cent, closed=False)[3])
         dist = math.hypot(y_obs - nominal[3, 1], nominal[3, 2])
         v = rod_v[mid]
+        # the contact forces on the rod's vertices, split along and across its centreline:
+        # a frictionless contact pushes across it, so an axial part is the sections' pull
+        # on their own edges' stretch (they thin with it), and the load across it summed
+        # over +-WINDOW D0 of the middle is a line load that no single vertex aliases
+        tang = np.gradient(xr, axis=0)
+        tang /= np.linalg.norm(tang, axis=1)[:, None]
+        gr = g[rod_v]
+        axial = np.einsum("ij,ij->i", gr, tang)
+        across_v = gr - axial[:, None] * tang
+        across = np.linalg.norm(across_v, axis=1)
+        h = 2.0 * half / n_rod
+        k_win = max(1, int(round(WINDOW * d0 / h)))
+        k_diag = max(1, int(round(0.5 * d0 / h)))
+        win = slice(mid - k_win, mid + k_win + 1)
+        near_half = slice(mid - k_diag, mid + k_diag + 1)
+        # the vector sum: force couples between neighbouring vertices (a section's modes
+        # turn with its edge) cancel in it
+        f_win = float(np.linalg.norm(across_v[win].sum(axis=0))) / ((2 * k_win + 1) * h
+                                                                     * stretch)
+        top = float(across[near_half].max())
         return {
             "tension": tension, "tension_over_e_d0sq": tension / (youngs_modulus * d0**2),
             "approach_over_d0": (d0 - dist) / d0, "axial_stretch_mid": stretch,
@@ -192,6 +228,9 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
             "force_per_length_mid_centroid": f_cent,
             "peak_pressure_over_e": float(rep["peak_pressure_over_E"][v]),
             "contact_width_fraction_mid": float(rep["contact_width_fraction"][v]),
+            "force_per_length_mid_window_over_e_d0": f_win / (youngs_modulus * d0),
+            "contact_axial_over_across_mid": (float(np.abs(axial[near_half]).max()) / top
+                                              if top > 0.0 else 0.0),
         }
 
     rows = _solve_levels(system, load, list(tension_levels), measure)
