@@ -316,3 +316,21 @@ def test_a_bend_shift_without_the_sectioned_level_exits_2(tmp_path, capsys) -> N
                  "--nodes", "60", "--out", str(out)]) == 2
     assert "section_bend_shift" in capsys.readouterr().err
     assert not out.exists()  # refused before anything is written
+
+
+def test_section_thinning_without_the_sectioned_level_exits_2(tmp_path, capsys) -> None:
+    out = tmp_path / "run"
+    assert main(["tie", "closed", "--contact", "compliant", "--section-thinning", "rod",
+                 "--nodes", "60", "--out", str(out)]) == 2
+    assert "section_thinning" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_an_unknown_section_thinning_exits_2(tmp_path, capsys) -> None:
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as bad:  # argparse's choices: exit code 2
+        main(["tie", "closed", "--contact", "sectioned", "--section-thinning", "mean",
+              "--out", str(out)])
+    assert bad.value.code == 2
+    assert "--section-thinning" in capsys.readouterr().err
+    assert not out.exists()

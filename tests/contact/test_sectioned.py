@@ -114,16 +114,17 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
              arr([0.5, 0.5], f), arr([0.5, 0.5], f), arr([1.0, 1.0], f),
              arr([0, int(rigid_b)], wp.int32), arr(offs, wp.int32),
              arr([[0, 0], [0, 0]], wp.vec2i), arr([0.0, 0.0], f), arr(GAUSS[0], f),
-             arr(GAUSS[1], f), K, 32, 1000.0, 1e-4]
+             arr(GAUSS[1], f), K, 32, 1000.0, 1e-4, 0]
     data = [arr(np.array([a.x0, a.x1, b.x0, b.x1]), wp.vec3d),
             arr(np.concatenate([a.coeffs0, a.coeffs1, b.coeffs0, b.coeffs1]), f),
             arr([a.t_ref, b.t_ref], wp.vec3d), arr([a.d1_ref, b.d1_ref], wp.vec3d),
             arr([a.twist1, b.twist1], f), arr([a.rest, b.rest], f),
-            arr([a.arc, b.arc], wp.vec2d), arr([1.0, 1.0], f), arr([[0, 1]], wp.vec2i),
-            arr(np.arange(16), wp.int32)]
+            arr([a.arc, b.arc], wp.vec2d), arr([1.0, 1.0], f), arr([1.0], f),
+            arr([[0, 1]], wp.vec2i), arr(np.arange(16), wp.int32)]
     bsz = 3 + K
     outs = [wp.zeros(2, dtype=f), wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),
-            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f)]
+            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f),
+            wp.zeros(1, dtype=f)]
     wp.launch(sk.DERIVATIVES, 2, model + data, outs)
     g = outs[2].numpy().reshape(2, nl)
     grad = g[0].copy()
@@ -237,6 +238,30 @@ def test_the_level_in_a_rod_system_has_a_consistent_gradient_and_hessian() -> No
     check_derivatives(system, d0, rng)
 
 
+def test_sections_thinned_by_the_rods_mean_stretch_have_an_exact_gradient() -> None:
+    # As above, with thinning="rod": every section of a rod thins with its mean stretch,
+    # whose chain rule through all the rod's edges is the host's (the kernel's dE/dlam;
+    # here 19 % of the contact gradient's norm). The rods press 0.03 D0 into each other:
+    # the first one's 5 % stretch thins its radius by 2.5 %.
+    d0 = 0.0085
+    mat = Material(1.25e6, 0.5, 1160.0)
+    b = RodBuilder(twist=False)
+    z = np.linspace(-1.5 * d0, 1.5 * d0, 25)
+    b.add_rod(np.c_[np.zeros(25), np.zeros(25), z], d0, mat)
+    b.add_rod(np.c_[z, np.full(25, 0.97 * d0), np.zeros(25)], d0, mat)
+    model = b.finalize()
+    rng = np.random.default_rng(0)
+    state = State.initial(model)
+    state.x[:25] *= np.array([1.0, 1.0, 1.05])  # the first rod 5 % longer than at rest
+    state.x += 1e-4 * d0 * rng.normal(size=state.x.shape)
+    system = RodSystem(model, state, BoundaryConditions(model))
+    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=32, thinning="rod"))
+    system.add_term(layer)
+    assert layer.rod_mean.rod_stretch(state.x, system.rest)[0] == pytest.approx(1.05,
+                                                                              rel=1e-3)
+    check_derivatives(system, d0, rng)
+
+
 def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator) -> None:
     """A rod system with a sectioned level, its sections deformed at random (0.002 D0): the
     contact is on, the gradient is exact along three random directions (central
@@ -263,7 +288,8 @@ def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator) ->
                                                ({"max_mode": 8.5}, "section_modes"),
                                                ({"samples": 16}, "samples"),
                                                ({"penalty": -1.0}, "penalty"),
-                                               ({"onset": 0.5}, "onset")])
+                                               ({"onset": 0.5}, "onset"),
+                                               ({"thinning": "mean"}, "thinning")])
 def test_bad_settings_name_the_option(kwargs: dict, word: str) -> None:
     with pytest.raises(ValueError, match=word):
         SectionSettings(**kwargs)

@@ -46,6 +46,7 @@ import warp as wp
 
 from tightknot.contact import sectioned_kernels as sk
 from tightknot.contact.layer import ContactLayer
+from tightknot.contact.rod_mean_radius import RodMeanRadius
 from tightknot.contact.section_modes import mode_stiffness
 from tightknot.contact.section_shift import MIN_CHORD, SectionShift
 from tightknot.rods.model import Model
@@ -144,6 +145,15 @@ class SectionSettings:
         bend_shift_chord: the chord [D0] the shift's curvature is taken over, each side
             (2 D0: of the chords tried, the one the FEM's clasp and wraps agree with best,
             docs/sectioned_level.md; at least 0.75).
+        thinning: the stretch that thins the sections, R^2 = r0^2 lam^(-2 nu) - |c|^2 / 2:
+            "edge" (the default), each edge's own; "rod", its rod's mean stretch L/L0, as
+            the compliant level's default since issue 17
+            (:mod:`tightknot.contact.rod_mean_radius`). With "edge" the contact energy
+            drops as the edges it presses stretch, which pulls them apart (axial contact
+            forces up to twice the normal ones in the FEM wrap, docs/sectioned_level.md,
+            "Resolution"); with "rod" the gradient is exact and the Hessian leaves out the
+            rank-2 coupling through each rod's length (of order R / L against the contact
+            stiffness).
     """
 
     max_mode: int = 8
@@ -152,8 +162,12 @@ class SectionSettings:
     onset: float = 1e-4
     bend_shift: bool = False
     bend_shift_chord: float = 2.0
+    thinning: str = "edge"
 
     def __post_init__(self) -> None:
+        if self.thinning not in ("edge", "rod"):
+            raise ValueError(f"section thinning must be 'edge' or 'rod', got "
+                             f"{self.thinning!r}")
         if (isinstance(self.max_mode, bool) or int(self.max_mode) != self.max_mode
                 or self.max_mode < MIN_MODES):
             raise ValueError(f"section_modes must be an integer >= {MIN_MODES} (an ellipse "
@@ -284,7 +298,12 @@ class SectionedLayer(ContactLayer):
             self.broad_phase.edge_exclusion,
             wp.array(g_xi, dtype=f64, device=dev), wp.array(g_w, dtype=f64, device=dev),
             k, int(self.section.samples), float(self.penalty), float(self.section.onset),
+            int(self.section.thinning == "rod"),
         ]
+        #: Each rod's mean stretch (the sections' thinning with ``thinning="rod"``).
+        self.rod_mean = (RodMeanRadius(m, self.edge_nu) if self.section.thinning == "rod"
+                         else None)
+        self._in_lam = Staging(f64, dev)
         self._in_coeff = Staging(f64, dev)
         self._in_t = Staging(wp.vec3d, dev)
         self._in_d1 = Staging(wp.vec3d, dev)
@@ -405,7 +424,10 @@ class SectionedLayer(ContactLayer):
         vertices)."""
         ev = self._ev
         length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
-        reach = 1.1 * self.edge_r0 * np.maximum(1.0, (length / rest) ** (-self.edge_nu))
+        lam = length / rest
+        if self.rod_mean is not None:
+            lam = np.minimum(lam, self.rod_mean.stretch(x, rest))
+        reach = 1.1 * self.edge_r0 * np.maximum(1.0, lam ** (-self.edge_nu))
         if extra.size:
             k = self.section.coeff_count
             vsum = np.zeros(self.model.vertex_count)
@@ -450,13 +472,17 @@ class SectionedLayer(ContactLayer):
         ns = threads * ng * self.section.samples if report else 1
         s_pen = wp.zeros(ns, dtype=f64, device=dev)
         s_wt = wp.zeros(ns, dtype=f64, device=dev)
+        with_lam = derivatives and self.rod_mean is not None
+        dlam = wp.zeros(2 * threads if with_lam else 1, dtype=f64, device=dev)
         wp.launch(kernel, threads, [*self._model_args, wx, *data,
                                     self.broad_phase.buffer_of(pairs), w_slots],
-                  [energy, pen_max, grad, blocks, s_pen, s_wt], device=dev)
+                  [energy, pen_max, grad, blocks, s_pen, s_wt, dlam], device=dev)
         out = {"energy": energy.numpy(), "pen_max": pen_max.numpy()}
         if derivatives:
             out["grad"] = grad.numpy().reshape(threads, nl)
             out["blocks"] = blocks.numpy().reshape(block_count, b, b)
+        if with_lam:
+            out["dlam"] = dlam.numpy().reshape(threads, 2)
         if report:
             out["pen"] = s_pen.numpy().reshape(threads, ng, self.section.samples)
             out["weight"] = s_wt.numpy().reshape(threads, ng, self.section.samples)
@@ -464,12 +490,38 @@ class SectionedLayer(ContactLayer):
 
     def _state_arrays(self, extra: np.ndarray, t_ref: np.ndarray, d1_ref: np.ndarray,
                       m_ref: np.ndarray, rest: np.ndarray, arcs: wp.array,
-                      rod_len: wp.array) -> list[wp.array]:
-        """The kernels' Data-in arrays after the positions."""
+                      rod_len: wp.array, x: np.ndarray) -> list[wp.array]:
+        """The kernels' Data-in arrays after the positions (``x`` [m]: the boundaries'
+        centres, whose rods' mean stretch thins the sections with ``thinning="rod"``)."""
+        lam = (self.rod_mean.stretch(x, rest) if self.rod_mean is not None
+               else np.zeros(1))
         return [self._in_coeff.put(extra if extra.size else np.zeros(1)),
                 self._in_t.put(t_ref), self._in_d1.put(d1_ref),
                 self._in_twist.put(self.end_twist(m_ref)), self._in_rest.put(rest), arcs,
-                rod_len]
+                rod_len, self._in_lam.put(lam)]
+
+    def _rod_mean_gradient(self, x: np.ndarray, rest: np.ndarray, pairs: np.ndarray,
+                           dlam: np.ndarray) -> np.ndarray:
+        """The gradient over positions (V, 3) [N] that the contact energy has through its
+        rods' mean stretches s_r = L_r / L0_r (``thinning="rod"``): sum_r G_r grad s_r,
+        G_r the passes' dE/dlam (``dlam``, (2 P, 2): each pass's A and B side) summed over
+        the rods, grad s_r = (1/L0_r) sum_e dl_e/dx (Bergou et al. 2008 stretching: dl/dx
+        = -+ t at an edge's ends)."""
+        m = self.model
+        ev = self._ev
+        nrod = len(m.rods)
+        order = np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)  # pass: A, B
+        rod_of = np.asarray(m.edge_rod, dtype=np.int64)
+        big_g = (np.bincount(rod_of[order[:, 0]], dlam[:, 0], nrod)
+                 + np.bincount(rod_of[order[:, 1]], dlam[:, 1], nrod))
+        rest_len = np.bincount(rod_of, rest, nrod)
+        e = x[ev[:, 1]] - x[ev[:, 0]]
+        t = e / np.linalg.norm(e, axis=1)[:, None]
+        w = (big_g / rest_len)[rod_of][:, None] * t
+        g = np.zeros((m.vertex_count, 3))
+        np.add.at(g, ev[:, 1], w)
+        np.add.at(g, ev[:, 0], -w)
+        return g
 
     def _pass_dofs(self, pairs: np.ndarray) -> np.ndarray:
         """Extended dofs (model dofs, then model.dof_count + the term's) of each pass's
@@ -501,7 +553,7 @@ class SectionedLayer(ContactLayer):
         if shifted is not None:
             x = shifted.x
         wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
-        data = self._state_arrays(extra, *frames, rest, arcs, rod_len)
+        data = self._state_arrays(extra, *frames, rest, arcs, rod_len, x)
         npairs = pairs.shape[0]
         g_x = np.zeros((m.vertex_count, 3)) if (want_grad or want_hess) else None
         g_c = np.zeros(self.dof_count) if (want_grad or want_hess) else None
@@ -539,6 +591,8 @@ class SectionedLayer(ContactLayer):
         full = np.bincount(dofs[keep], weights=out["grad"][keep],
                            minlength=m.dof_count + self.dof_count)
         g_x = full[m.position_dofs]
+        if self.rod_mean is not None:
+            g_x = g_x + self._rod_mean_gradient(x, rest, act_pairs, out["dlam"])
         g_c = full[m.dof_count:]
         hess = None
         if want_hess:
@@ -597,7 +651,8 @@ class SectionedLayer(ContactLayer):
         * ``half_width``: L_c pi D0 / 4 [m], the half-width of each of two opposite
           contacts sharing the width;
         * ``area_ratio``: A/A0 = lambda^(-2 nu), lambda the stretch of the vertex's edges
-          (the modes keep the area, docs/sectioned_level.md).
+          (their rod's mean with ``thinning="rod"``; the modes keep the area,
+          docs/sectioned_level.md).
         """
         m = self.model
         rest = np.asarray(rest, dtype=np.float64)
@@ -607,7 +662,7 @@ class SectionedLayer(ContactLayer):
         ms = self.section.samples
         x = self.boundary_centres(x, rest)  # the boundaries' centres and mean stretch
         wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
-        data = self._state_arrays(extra, *frames, rest, arcs, rod_len)
+        data = self._state_arrays(extra, *frames, rest, arcs, rod_len, x)
         pen = np.zeros((n_e, ng, ms))
         if pairs.shape[0]:
             out = self._launch(sk.REPORT, wx, pairs, data, report=True)
@@ -624,7 +679,8 @@ class SectionedLayer(ContactLayer):
         basis[:, 0::2], basis[:, 1::2] = np.cos(npk), np.sin(npk)
         slope[:, 0::2], slope[:, 1::2] = -self.modes * np.sin(npk), self.modes * np.cos(npk)
         length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
-        lam = length / rest
+        lam = (length / rest if self.rod_mean is None
+               else self.rod_mean.stretch(x, rest))
         big_r0 = self.edge_r0 * lam ** (-self.edge_nu)
         in_contact = pen > 0.0
         width = np.zeros((n_e, ng))

@@ -459,6 +459,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         samples: int,
         penalty: wp.float64,
         onset: wp.float64,
+        rod_mean: int,
         # Data in:
         x_in: wp.array(dtype=wp.vec3d),
         coeff_in: wp.array(dtype=wp.float64),
@@ -468,6 +469,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         rest_in: wp.array(dtype=wp.float64),
         arc_in: wp.array(dtype=wp.vec2d),
         rod_length_in: wp.array(dtype=wp.float64),
+        lam_in: wp.array(dtype=wp.float64),
         pairs_in: wp.array(dtype=wp.vec2i),
         slots_in: wp.array(dtype=wp.int32),
         # Out:
@@ -477,6 +479,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         blocks_out: wp.array(dtype=wp.float64),
         sample_pen_out: wp.array(dtype=wp.float64),
         sample_weight_out: wp.array(dtype=wp.float64),
+        dlam_out: wp.array(dtype=wp.float64),
     ):
         tid = wp.tid()
         pr = pairs_in[tid // 2]
@@ -515,6 +518,11 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         cb1 = load_section(coeff_in, vertex_offset[vb[1]], k)
         lam_a = la / rest_in[ea]
         lam_b = lb / rest_in[eb]
+        if rod_mean != 0:
+            # the sections thin with their rods' mean stretch, given per edge (its chain
+            # rule through the rods' lengths is the host's, from dlam_out)
+            lam_a = lam_in[ea]
+            lam_b = lam_in[eb]
         # Largest boundary radii: the mean radius is at most r0 lam^-nu, a vertex's modes
         # move the boundary by at most their amplitudes' sum (turning keeps each mode's
         # amplitude), and over the partner's reach (v in [-1/2, 3/2]) the interpolation
@@ -565,6 +573,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         mtb = end_twist_in[eb]
         go = tid * nl
         touched = int(0)
+        dlam_a = f64(0.0)
+        dlam_b = f64(0.0)
         if wp.static(derivatives):
             # The pass's Hessian over (x_A0, x_A1, x_B0, x_B1, c_A0, c_A1, c_B0, c_B1),
             # summed over its samples in registers: the coordinates' block, the
@@ -672,7 +682,18 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         rbpsiv = wp.dot(bpsi1, dcb)
                     # P over the reduced directions: x_A0, x_A1 and A's section direction
                     m_dir = cphi * fa.m1 + sphi * fa.m2
-                    dra = (ra_l / rest_in[ea]) * ta
+                    # the radii's stretch partials through the pass's own edges (none
+                    # when the stretch is the rod's mean)
+                    ra_lx = ra_l
+                    ra_llx = ra_ll
+                    rb_lx = rb_l
+                    rb_llx = rb_ll
+                    if rod_mean != 0:
+                        ra_lx = f64(0.0)
+                        ra_llx = f64(0.0)
+                        rb_lx = f64(0.0)
+                        rb_llx = f64(0.0)
+                    dra = (ra_lx / rest_in[ea]) * ta
                     dp_de = u * eye + r_a * m_dir + wp.outer(dirv, dra)
                     jr = mat6x16d()
                     for i in range(3):
@@ -689,11 +710,20 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                                          / (lb * rest_in[eb]))
                     gpsi = cyl.gpsi
                     gv = cyl.gv
-                    g_we = cyl.grho - r_b1 * gpsi - rbv * gv - rb_l * lam_dir
+                    g_we = cyl.grho - r_b1 * gpsi - rbv * gv - rb_lx * lam_dir
                     h_we = (cyl.hrho - r_b2 * wp.outer(gpsi, gpsi) - r_b1 * cyl.hpsi
                             - rbvv * wp.outer(gv, gv) - rbv * cyl.hv
                             - rbpsiv * (wp.outer(gpsi, gv) + wp.outer(gv, gpsi))
-                            - rb_ll * wp.outer(lam_dir, lam_dir) - rb_l * lam_hess)
+                            - rb_llx * wp.outer(lam_dir, lam_dir) - rb_lx * lam_hess)
+                    if rod_mean != 0:
+                        # dE/dlam of each side's stretch: A's sample moves along its
+                        # direction d by dR_A/dlam, changing pen (dpen/dw = -g_we) and the
+                        # partition's v (dv/dw = gv); B's radius grows by dR_B/dlam
+                        dwa = wp.vec3d(g_we[0], g_we[1], g_we[2])
+                        dva = wp.vec3d(gv[0], gv[1], gv[2])
+                        dlam_a += a_s * ra_l * (-wt * ph[1] * wp.dot(dwa, dirv)
+                                                + ph[0] * wt1 * wp.dot(dva, dirv))
+                        dlam_b += a_s * wt * ph[1] * rb_l
                     r_g = wp.transpose(jr) @ g_we
                     r_v = wp.transpose(jr) @ gv
                     r_psi = wp.transpose(jr) @ gpsi
@@ -708,8 +738,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                             hg[15, c] = hg[15, c] - r_v[c]
                     # P's own second derivatives in A's edge vector, contracted with dg/dw
                     # and dv/dw
-                    hra = ((ra_ll / (rest_in[ea] * rest_in[ea])) * wp.outer(ta, ta)
-                           + (ra_l / (la * rest_in[ea])) * (eye - wp.outer(ta, ta)))
+                    hra = ((ra_llx / (rest_in[ea] * rest_in[ea])) * wp.outer(ta, ta)
+                           + (ra_lx / (la * rest_in[ea])) * (eye - wp.outer(ta, ta)))
                     for side in range(2):
                         gw = wp.vec3d(g_we[0], g_we[1], g_we[2])
                         if side == 1:
@@ -834,6 +864,10 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 3, h_a0b1, 0)
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 2, h_a1b0, 0)
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 3, h_a1b1, 0)
+        if wp.static(derivatives):
+            if rod_mean != 0:
+                dlam_out[2 * tid] = dlam_a
+                dlam_out[2 * tid + 1] = dlam_b
         energy_out[tid] = energy
         pen_max_out[tid] = pen_max
 

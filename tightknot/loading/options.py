@@ -294,6 +294,11 @@ class LoadPath:
                                      "toward its bend's centre by nu kappa R^2 / 2 "
                                      "(Saint-Venant's anticlastic shift; off by default: "
                                      "docs/sectioned_level.md)")
+    section_thinning: str = param("edge", ("edge", "rod"), "",
+                                  "at the sectioned contact level, the stretch that thins "
+                                  "the sections: each edge's own (edge) or the rod's mean "
+                                  "L/L0 (rod: no axial pull of the contact on the edges it "
+                                  "presses; docs/sectioned_level.md, 'Resolution')")
 
 
 #: The loads of an open knot's pull: a run gives exactly one of them.

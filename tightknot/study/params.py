@@ -267,7 +267,12 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     if shift and values["contact"] != "sectioned":
         raise ValueError(f"section_bend_shift: on needs contact sectioned, got contact "
                          f"{values['contact']}")
-    contact = (SectionSettings(max_mode=values["section_modes"], bend_shift=shift)
+    thinning = values.get("section_thinning", "edge")
+    if thinning != "edge" and values["contact"] != "sectioned":
+        raise ValueError(f"section_thinning: {thinning} needs contact sectioned, got contact "
+                         f"{values['contact']}")
+    contact = (SectionSettings(max_mode=values["section_modes"], bend_shift=shift,
+                               thinning=thinning)
                if values["contact"] == "sectioned" else values["contact"])
     if values.get("start") is not None:
         from tightknot.knots import start_curve

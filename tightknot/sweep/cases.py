@@ -52,7 +52,8 @@ CASE_KEYS: dict[str, tuple[str, ...]] = {
 #: is an opt-in the FEM does not back (docs/sectioned_level.md), so sweeps run without it.
 NOT_CASE_KEYS = ("pull_steps", "relax_iterations", "end_distance", "force", "target_lambda",
                  "coarse_nodes", "color_by", "device", "start", "units", "columns",
-                 "start_shape", "section_path", "section_bend_shift")
+                 "start_shape", "section_path", "section_bend_shift",
+                 "section_thinning")
 #: Level lists of an open knot -> the load each level is (its range and unit).
 LEVELS = {"pull_force": "force", "target_lambda": "target_lambda"}
 LEVEL_KEYS = tuple(LEVELS)
