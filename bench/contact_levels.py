@@ -5,7 +5,9 @@ ratios, not seconds: the machines are shared).
 Usage: ``python bench/contact_levels.py [--closed-nodes 100] [--open-nodes 150]
 [--levels compliant smoothed] [--section-path auto] [--json out.json]``. The level
 ``sectioned-shift`` is the sectioned level with its bend shift
-(``SectionSettings(bend_shift=True)``, docs/sectioned_level.md).
+(``SectionSettings(bend_shift=True)``, docs/sectioned_level.md); ``sectioned-rod`` the
+sectioned level with its sections thinned by the rod's mean stretch
+(``SectionSettings(thinning="rod")``).
 """
 
 from __future__ import annotations
@@ -34,7 +36,11 @@ OPEN_CASES = (("open_125mm_to_10.1", 0.125, 10.1), ("open_185mm_to_15", 0.185, 1
 
 def _contact(level: str) -> str | SectionSettings:
     """The scenes' contact of a benchmark level."""
-    return SectionSettings(bend_shift=True) if level == "sectioned-shift" else level
+    if level == "sectioned-shift":
+        return SectionSettings(bend_shift=True)
+    if level == "sectioned-rod":
+        return SectionSettings(thinning="rod")
+    return level
 
 
 def closed_case(level: str, nodes: int, section_path: str = "auto") -> dict:
@@ -67,7 +73,16 @@ def open_case(level: str, nodes: int, name: str, length: float, target: float,
             "converged": res.converged,
             "failure": res.failure, "knot_types": sorted(set(res.knot_types)),
             "newton_iterations": res.newton_iterations, "wall_time_s": wall,
-            "lambda_oc": lam, "pull_force_N": res.pull_force_N}
+            "lambda_oc": lam, "pull_force_N": res.pull_force_N,
+            **_edge_stretch(x, res.system.rest)}
+
+
+def _edge_stretch(x: np.ndarray, rest: np.ndarray) -> dict:
+    """The edges' largest stretch and its ratio to their median (an open rod: the edges
+    between consecutive vertices; the nip's edges pulled apart show as a large ratio)."""
+    lam = np.linalg.norm(np.diff(x, axis=0), axis=1) / np.asarray(rest)[: len(x) - 1]
+    return {"edge_stretch_max": float(lam.max()),
+            "edge_stretch_max_over_median": float(lam.max() / np.median(lam))}
 
 
 def main() -> None:
@@ -76,7 +91,7 @@ def main() -> None:
     parser.add_argument("--open-nodes", type=int, default=150)
     parser.add_argument("--levels", nargs="+", default=["compliant", "smoothed"],
                         choices=["compliant", "smoothed", "sectioned", "sectioned-shift",
-                                 "rigid"])
+                                 "sectioned-rod", "rigid"])
     parser.add_argument("--section-path", default="auto", choices=["auto", "final", "full"],
                         help="the sectioned level's load path (tightknot.loading.tie.path_scene)")
     parser.add_argument("--json", default=None)

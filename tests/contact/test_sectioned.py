@@ -23,6 +23,7 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material
 from tightknot.rods.state import State
+from tightknot.solvers.linear import SparseDirect
 from tightknot.solvers.system import RodSystem
 
 MODES = np.arange(2, 9)
@@ -259,10 +260,13 @@ def test_sections_thinned_by_the_rods_mean_stretch_have_an_exact_gradient() -> N
     system.add_term(layer)
     assert layer.rod_mean.rod_stretch(state.x, system.rest)[0] == pytest.approx(1.05,
                                                                               rel=1e-3)
-    check_derivatives(system, d0, rng)
+    # the Hessian with its dense part through the rods' lengths (central differences of
+    # the kernel in each rod's stretch): measured 2e-5 relative here, 3e-4 without it
+    check_derivatives(system, d0, rng, hess_tol=1e-4)
 
 
-def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator) -> None:
+def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator,
+                      hess_tol: float = 0.03) -> None:
     """A rod system with a sectioned level, its sections deformed at random (0.002 D0): the
     contact is on, the gradient is exact along three random directions (central
     differences; measured 1e-9 relative) and the Hessian within 3 % (it leaves out the
@@ -281,7 +285,7 @@ def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator) ->
         g_lo = system.evaluate(u - step * d, True, False)[1]
         assert g @ d == pytest.approx((e_hi - e_lo) / (2 * step), rel=1e-6)
         hd = (g_hi - g_lo) / (2 * step)
-        assert np.linalg.norm(h @ d - hd) <= 0.03 * np.linalg.norm(hd)
+        assert np.linalg.norm(SparseDirect.matrix(h) @ d - hd) <= hess_tol * np.linalg.norm(hd)
 
 
 @pytest.mark.parametrize(("kwargs", "word"), [({"max_mode": 3}, "section_modes"),

@@ -151,9 +151,10 @@ class SectionSettings:
             (:mod:`tightknot.contact.rod_mean_radius`). With "edge" the contact energy
             drops as the edges it presses stretch, which pulls them apart (axial contact
             forces up to twice the normal ones in the FEM wrap, docs/sectioned_level.md,
-            "Resolution"); with "rod" the gradient is exact and the Hessian leaves out the
-            rank-2 coupling through each rod's length (of order R / L against the contact
-            stiffness).
+            "Resolution"); with "rod" the gradient is exact and the Hessian's dense part
+            through each rod's length (rank 2 per rod, solved by the Woodbury identity)
+            comes from central differences of the kernel in the rod's stretch (it costs
+            two more kernel launches per rod and Hessian). Not with ``bend_shift``.
     """
 
     max_mode: int = 8
@@ -168,6 +169,9 @@ class SectionSettings:
         if self.thinning not in ("edge", "rod"):
             raise ValueError(f"section thinning must be 'edge' or 'rod', got "
                              f"{self.thinning!r}")
+        if self.thinning == "rod" and self.bend_shift:
+            raise ValueError("section thinning 'rod' and bend_shift are not built together "
+                             "(the shift's stretch is the offset line's own)")
         if (isinstance(self.max_mode, bool) or int(self.max_mode) != self.max_mode
                 or self.max_mode < MIN_MODES):
             raise ValueError(f"section_modes must be an integer >= {MIN_MODES} (an ellipse "
@@ -304,6 +308,7 @@ class SectionedLayer(ContactLayer):
         self.rod_mean = (RodMeanRadius(m, self.edge_nu) if self.section.thinning == "rod"
                          else None)
         self._in_lam = Staging(f64, dev)
+        self._in_lam_fd = Staging(f64, dev)
         self._in_coeff = Staging(f64, dev)
         self._in_t = Staging(wp.vec3d, dev)
         self._in_d1 = Staging(wp.vec3d, dev)
@@ -501,12 +506,12 @@ class SectionedLayer(ContactLayer):
                 rod_len, self._in_lam.put(lam)]
 
     def _rod_mean_gradient(self, x: np.ndarray, rest: np.ndarray, pairs: np.ndarray,
-                           dlam: np.ndarray) -> np.ndarray:
+                           dlam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The gradient over positions (V, 3) [N] that the contact energy has through its
         rods' mean stretches s_r = L_r / L0_r (``thinning="rod"``): sum_r G_r grad s_r,
         G_r the passes' dE/dlam (``dlam``, (2 P, 2): each pass's A and B side) summed over
         the rods, grad s_r = (1/L0_r) sum_e dl_e/dx (Bergou et al. 2008 stretching: dl/dx
-        = -+ t at an edge's ends)."""
+        = -+ t at an edge's ends); and G_r [J] per rod."""
         m = self.model
         ev = self._ev
         nrod = len(m.rods)
@@ -521,7 +526,86 @@ class SectionedLayer(ContactLayer):
         g = np.zeros((m.vertex_count, 3))
         np.add.at(g, ev[:, 1], w)
         np.add.at(g, ev[:, 0], -w)
-        return g
+        return g, big_g
+
+    def _rod_mean_low_rank(self, wx: wp.array, wp_act: wp.array, data: list[wp.array],
+                           slots: np.ndarray, block_count: int, act_pairs: np.ndarray,
+                           dofs: np.ndarray, x: np.ndarray, rest: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray]:
+        """The dense part of the Hessian through the rods' mean stretches s_r
+        (``thinning="rod"``; the chain rule of :mod:`tightknot.contact.rod_mean_radius`):
+        U C U^T with U = [grad s_r .., w_r ..] over the extended dofs and C = [[S, I], [I,
+        0]], w_r = d(grad E)/ds_r at fixed dofs and S_rq = d^2 E / ds_r ds_q. Both come from
+        central differences of the derivative kernel in each deformable rod's stretch
+        (step 1e-6: truncation 1e-12, round-off 1e-10 of the entries)."""
+        m = self.model
+        nrod = len(m.rods)
+        rod_of = np.asarray(m.edge_rod, dtype=np.int64)
+        lam = self.rod_mean.stretch(x, rest)
+        rods = sorted({int(r) for r in rod_of[act_pairs.ravel()]
+                       if not self.edge_rigid[m.rods[int(r)].edge_slice.start]})
+        ext = m.dof_count + self.dof_count
+        keep = dofs >= 0
+        eps = 1e-6
+        w_cols, s_cols = [], []
+        for r in rods:
+            sides = []
+            for sign in (1.0, -1.0):
+                lam_r = lam.copy()
+                lam_r[rod_of == r] += sign * eps
+                out = self._launch(sk.DERIVATIVES, wx, wp_act,
+                                   [*data[:-1], self._in_lam_fd.put(lam_r)], derivatives=True,
+                                   slots=slots, block_count=block_count)
+                # the gradient at fixed stretch (the chain term G grad s is not in w)
+                full = np.bincount(dofs[keep], weights=out["grad"][keep], minlength=ext)
+                order = np.stack([act_pairs, act_pairs[:, ::-1]], axis=1).reshape(-1, 2)
+                big_g = (np.bincount(rod_of[order[:, 0]], out["dlam"][:, 0], nrod)
+                         + np.bincount(rod_of[order[:, 1]], out["dlam"][:, 1], nrod))
+                sides.append((full, big_g))
+            w_cols.append((sides[0][0] - sides[1][0]) / (2.0 * eps))
+            s_cols.append((sides[0][1] - sides[1][1]) / (2.0 * eps))
+        k = len(rods)
+        s_mat = np.array([[s_cols[j][rods[i]] for j in range(k)] for i in range(k)])
+        s_mat = 0.5 * (s_mat + s_mat.T)
+        ev = self._ev
+        rest_len = np.bincount(rod_of, rest, nrod)
+        e = x[ev[:, 1]] - x[ev[:, 0]]
+        t = e / np.linalg.norm(e, axis=1)[:, None]
+        grads = []
+        for r in rods:
+            g = np.zeros((m.vertex_count, 3))
+            mine = rod_of == r
+            np.add.at(g, ev[mine, 1], t[mine] / rest_len[r])
+            np.add.at(g, ev[mine, 0], -t[mine] / rest_len[r])
+            col = np.zeros(ext)
+            col[m.position_dofs] = g
+            grads.append(col)
+        u = np.column_stack(grads + w_cols)
+        c = np.block([[s_mat, np.eye(k)], [np.eye(k), np.zeros((k, k))]])
+        return u, c
+
+    def _add_stretch_blocks(self, hess: BlockHessian, x: np.ndarray, rest: np.ndarray,
+                            big_g: np.ndarray) -> None:
+        """Add sum_r G_r Hess s_r to ``hess``'s position blocks (``thinning="rod"``):
+        Hess s_r = (1/L0_r) sum_e [[P, -P], [-P, P]] / l_e over the rod's edges, P = I - t
+        t^T (the second derivative of an edge's length). Only the deformable edges' rods
+        have G_r != 0 (a rigid section does not thin), and their end pairs are among the
+        blocks (the section energy's)."""
+        m = self.model
+        ev = self._ev[self._section_edges]
+        rod_of = np.asarray(m.edge_rod, dtype=np.int64)
+        nrod = len(m.rods)
+        rest_len = np.bincount(rod_of, rest, nrod)
+        e = x[ev[:, 1]] - x[ev[:, 0]]
+        length = np.linalg.norm(e, axis=1)
+        t = e / length[:, None]
+        coef = (big_g / rest_len)[rod_of[self._section_edges]] / length
+        blk = coef[:, None, None] * (np.eye(3)[None] - t[:, :, None] * t[:, None, :])
+        nodes = m.vertex_count
+        hk = hess.keys[:, 0] * nodes + hess.keys[:, 1]
+        for (r, c), sign in (((0, 0), 1.0), ((1, 1), 1.0), ((0, 1), -1.0), ((1, 0), -1.0)):
+            slot = np.searchsorted(hk, ev[:, r] * nodes + ev[:, c])
+            np.add.at(hess.blocks[:, :3, :3], slot, sign * blk)
 
     def _pass_dofs(self, pairs: np.ndarray) -> np.ndarray:
         """Extended dofs (model dofs, then model.dof_count + the term's) of each pass's
@@ -591,14 +675,20 @@ class SectionedLayer(ContactLayer):
         full = np.bincount(dofs[keep], weights=out["grad"][keep],
                            minlength=m.dof_count + self.dof_count)
         g_x = full[m.position_dofs]
+        big_g = None
         if self.rod_mean is not None:
-            g_x = g_x + self._rod_mean_gradient(x, rest, act_pairs, out["dlam"])
+            g_mean, big_g = self._rod_mean_gradient(x, rest, act_pairs, out["dlam"])
+            g_x = g_x + g_mean
         g_c = full[m.dof_count:]
         hess = None
         if want_hess:
             hess = BlockHessian(self._node_dofs,
                                 np.stack([keys // m.vertex_count, keys % m.vertex_count], axis=1),
                                 out["blocks"])
+            if big_g is not None:
+                self._add_stretch_blocks(hess, x, rest, big_g)
+                hess.low_rank = self._rod_mean_low_rank(wx, wp_act, data, slots, keys.size,
+                                                        act_pairs, dofs, x, rest)
         if shifted is not None:
             # derivatives over the offset centreline carried to the centreline
             if hess is not None:

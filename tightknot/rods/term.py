@@ -39,6 +39,9 @@ class BlockHessian:
         full_rows, full_cols: whether each block's rows (columns) past a node's first 3
             dofs (its position) may be nonzero, (U,) bool; None: all may. A block that
             couples positions only then adds no structural zeros to the matrix.
+        low_rank: a dense update U C U^T of the Hessian beside the blocks, U over the
+            extended dofs (model dofs, then the term's), (model.dof_count + dof_count, m),
+            and C (m, m); None: none.
     """
 
     node_dofs: np.ndarray
@@ -46,6 +49,7 @@ class BlockHessian:
     blocks: np.ndarray
     full_rows: np.ndarray | None = None
     full_cols: np.ndarray | None = None
+    low_rank: tuple[np.ndarray, np.ndarray] | None = None
 
     def masks(self) -> tuple[np.ndarray, np.ndarray]:
         """``full_rows`` and ``full_cols``, all True where not given."""

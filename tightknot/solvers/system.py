@@ -300,12 +300,22 @@ class RodSystem:
             hmat = pattern.matrix(data)
             if coo_parts:
                 hmat = hmat + self._coo_free(coo_parts)
+            n_own = 0
             if own is not None:
                 hmat = self._with_own_hessian(hmat, own[1])
-            if low_rank:
-                free = self.pattern.free_dofs
-                hmat = LowRankHessian(hmat, np.hstack([u[free] for u, _ in low_rank]),
-                                      sla.block_diag(*[c for _, c in low_rank]))
+                n_own = self.dof_term.dof_count
+            free = self.pattern.free_dofs
+            # each update's columns over the free dofs, then the dof term's own (zero for a
+            # layer's update, which has none)
+            cols = [np.vstack([u[free], np.zeros((n_own, u.shape[1]))]) if n_own else u[free]
+                    for u, _ in low_rank]
+            cores = [c for _, c in low_rank]
+            if own is not None and own[1].low_rank is not None:
+                ue, c = own[1].low_rank
+                cols.append(np.vstack([ue[:m.dof_count][free], ue[m.dof_count:]]))
+                cores.append(c)
+            if cols:
+                hmat = LowRankHessian(hmat, np.hstack(cols), sla.block_diag(*cores))
         return split.total, g_free, hmat
 
     def term_gradient(self, term: EnergyTerm) -> np.ndarray:
