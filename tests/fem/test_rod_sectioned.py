@@ -58,3 +58,5 @@ def test_bad_section_modes_are_refused_before_the_fem_runs() -> None:
         crosscheck(mesh="coarse", contact="sectioned", section_modes=3)
     with pytest.raises(ValueError, match="contact must be one of"):
         crosscheck(mesh="coarse", contact="soft")
+    with pytest.raises(ValueError, match="thinning"):
+        crosscheck(mesh="coarse", contact="sectioned", thinning="mean")

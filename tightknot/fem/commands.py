@@ -88,6 +88,10 @@ def register(subparsers: Any) -> None:
                      help="crosscheck --contact sectioned: centre the sections on the tight "
                           "bend's offset centreline (Saint-Venant's anticlastic shift; "
                           "docs/sectioned_level.md)")
+    fem.add_argument("--section-thinning", default="edge", choices=["edge", "rod"],
+                     help="crosscheck --contact sectioned: the stretch that thins the "
+                          "sections, each edge's own (default) or the rod's mean "
+                          "(docs/sectioned_level.md, 'Resolution')")
     fem.add_argument("--fem-json", default=None, metavar="FILE",
                      help="crosscheck only: reuse the FEM results of an earlier crosscheck "
                           "report FILE (its fem_results) instead of running the FEM")
@@ -189,7 +193,8 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
                              f"fem_results ({err})")
         report = crosscheck(mesh=args.mesh or DEFAULT_MESH, fem_results=fem_results,
                             contact=args.contact, section_modes=args.section_modes,
-                            soft=not args.no_soft, bend_shift=args.section_bend_shift)
+                            soft=not args.no_soft, bend_shift=args.section_bend_shift,
+                            thinning=args.section_thinning)
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))
     if args.json is None:

@@ -342,10 +342,11 @@ def _warm_up() -> float:
 
 def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = None,
                contact: str = "compliant", section_modes: int = 8, soft: bool = True,
-               bend_shift: bool = False) -> dict[str, Any]:
+               bend_shift: bool = False, thinning: str = "edge") -> dict[str, Any]:
     """Run indent and wrap with the FEM (``mesh``) and the rod model at the contact level
     ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N,
-    ``bend_shift``: its sections centred on the bend's offset centreline) and
+    ``bend_shift``: its sections centred on the bend's offset centreline, ``thinning``:
+    the stretch that thins them, :class:`~tightknot.contact.sectioned.SectionSettings`) and
     compare them; with ``soft``, also the two-soft-rod scenes soft_wrap and clasp
     (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, at every level of
     :data:`~tightknot.fem.rod_model_soft.CONTACT_LEVELS` in a compliant report, at the
@@ -367,7 +368,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     if contact == "sectioned":
         from tightknot.contact.sectioned import SectionSettings
 
-        SectionSettings(max_mode=section_modes, bend_shift=bend_shift)  # bad input first
+        # bad input first
+        SectionSettings(max_mode=section_modes, bend_shift=bend_shift, thinning=thinning)
     fem_results = dict(fem_results or {})
     start = time.perf_counter()
     if "indent" not in fem_results:
@@ -376,14 +378,16 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         fem_results["wrap"] = run_scene("wrap", mesh=mesh, convergence=False)
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
     if contact == "sectioned":
-        report = _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift)
+        report = _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift,
+                                   thinning)
         if soft:
             from tightknot.contact.sectioned import SectionSettings
 
             from .crosscheck_soft import fem_runs, soft_rows
 
             fem_results = fem_runs(mesh, fem_results)
-            section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift)
+            section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift,
+                                      thinning=thinning)
             report["soft_scenes"] = soft_rows(mesh, fem_results, section=section,
                                               levels=("sectioned",))
             report["fem_results"].update({k: v for k, v in fem_results.items()
@@ -462,15 +466,15 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
 
 
 def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
-                      section_modes: int, start: float, bend_shift: bool = False
-                      ) -> dict[str, Any]:
+                      section_modes: int, start: float, bend_shift: bool = False,
+                      thinning: str = "edge") -> dict[str, Any]:
     """The cross-check of the sectioned level (:mod:`tightknot.fem.rod_sectioned`): force,
     A/A0, L_c and (wrap) curvature at every level, against the targets."""
     from tightknot.contact.sectioned import SectionSettings
 
     from .rod_sectioned import rod_indent_sectioned, rod_wrap_sectioned
 
-    section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift)
+    section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift, thinning=thinning)
     t0 = time.perf_counter()
     rod_indent_sectioned([0.01 * ROD_DIAMETER], length_over_d0=1.5, section=section)
     warm = time.perf_counter() - t0
@@ -513,6 +517,7 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
         "contact": "sectioned",
         "section_modes": section_modes,
         "section_bend_shift": bend_shift,
+        "section_thinning": thinning,
         "penalty_over_e_per_d0": rod_ind["penalty"],
         "mesh": mesh,
         "approach_limit_over_d0": APPROACH_LIMIT,
