@@ -1,7 +1,8 @@
 """The sectioned level's wrap under its two thinnings (rod model only, the FEM cross-check's
-wrap scene at its lightest tension, 12 edges per D0): a frictionless contact pushes across
-the rod, so an axial part of a vertex's contact force is the sections' pull on their own
-edges' stretch (docs/sectioned_level.md, "Resolution")."""
+wrap scene at its lightest tension, 12 edges per D0): the traction of a frictionless
+contact is across the rod, so an axial part of a vertex's contact force is the sections'
+pull on their own edges' stretch, a force pair per edge (docs/sectioned_level.md,
+"Resolution")."""
 
 import pytest
 

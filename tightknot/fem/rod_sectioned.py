@@ -159,7 +159,8 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
     centreline summed as vectors over +-``WINDOW`` D0 of the middle, per stretched
     length) and
     ``contact_axial_over_across_mid`` (within +-0.5 D0: the largest axial part of a
-    vertex's contact force over the largest part across; 0 for a frictionless contact)."""
+    vertex's contact force over the largest part across: the edges' thinning pull, as the
+    traction of a frictionless contact is all across)."""
     from tightknot.knots.curvature import bergou_curvature
 
     start = time.perf_counter()
@@ -197,10 +198,11 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
         kappa_cent = float(bergou_curvature(cent, closed=False)[3])
         dist = math.hypot(y_obs - nominal[3, 1], nominal[3, 2])
         v = rod_v[mid]
-        # the contact forces on the rod's vertices, split along and across its centreline:
-        # a frictionless contact pushes across it, so an axial part is the sections' pull
-        # on their own edges' stretch (they thin with it), and the load across it summed
-        # over +-WINDOW D0 of the middle is a line load that no single vertex aliases
+        # the contact term's forces on the rod's vertices, split along and across its
+        # centreline: the traction of a frictionless contact is across it, so an axial part
+        # is the sections' pull on their own edges' stretch (they thin with it, a force pair
+        # per edge), and the load across it summed over +-WINDOW D0 of the middle is a line
+        # load that no single vertex aliases
         tang = np.gradient(xr, axis=0)
         tang /= np.linalg.norm(tang, axis=1)[:, None]
         gr = g[rod_v]
