@@ -60,3 +60,7 @@ def test_bad_section_modes_are_refused_before_the_fem_runs() -> None:
         crosscheck(mesh="coarse", contact="soft")
     with pytest.raises(ValueError, match="thinning"):
         crosscheck(mesh="coarse", contact="sectioned", thinning="mean")
+    with pytest.raises(ValueError, match="edges_per_d0"):
+        crosscheck(mesh="coarse", contact="sectioned", rod_edges_per_d0=2)
+    with pytest.raises(ValueError, match="rod_edges_per_d0"):
+        crosscheck(mesh="coarse", contact="compliant", rod_edges_per_d0=24)

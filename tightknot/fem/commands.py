@@ -92,6 +92,10 @@ def register(subparsers: Any) -> None:
                      help="crosscheck --contact sectioned: the stretch that thins the "
                           "sections, each edge's own (default) or the rod's mean "
                           "(docs/sectioned_level.md, 'Resolution')")
+    fem.add_argument("--rod-edges-per-d0", type=int, default=None, metavar="N",
+                     help="crosscheck --contact sectioned: edges per D0 of the rod scenes "
+                          "(default 12; the 0.012 D0 indent needs 24 or more, "
+                          "docs/sectioned_level.md, 'Resolution')")
     fem.add_argument("--fem-json", default=None, metavar="FILE",
                      help="crosscheck only: reuse the FEM results of an earlier crosscheck "
                           "report FILE (its fem_results) instead of running the FEM")
@@ -194,7 +198,9 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
         report = crosscheck(mesh=args.mesh or DEFAULT_MESH, fem_results=fem_results,
                             contact=args.contact, section_modes=args.section_modes,
                             soft=not args.no_soft, bend_shift=args.section_bend_shift,
-                            thinning=args.section_thinning)
+                            thinning=args.section_thinning,
+                            **({} if args.rod_edges_per_d0 is None
+                               else {"rod_edges_per_d0": args.rod_edges_per_d0}))
     except (ValueError, FelupeMissingError) as err:
         return _fail(str(err))
     if args.json is None:

@@ -72,7 +72,7 @@ from typing import Any
 
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .material import ROD_DIAMETER
-from .rod_model import rod_indent, rod_wrap
+from .rod_model import EDGES_PER_D0, check_edges_per_d0, rod_indent, rod_wrap
 from .scenes._common import MESH_LEVELS, finite, relative
 
 DEFAULT_MESH: str = "medium"
@@ -342,11 +342,14 @@ def _warm_up() -> float:
 
 def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = None,
                contact: str = "compliant", section_modes: int = 8, soft: bool = True,
-               bend_shift: bool = False, thinning: str = "edge") -> dict[str, Any]:
+               bend_shift: bool = False, thinning: str = "edge",
+               rod_edges_per_d0: int = EDGES_PER_D0) -> dict[str, Any]:
     """Run indent and wrap with the FEM (``mesh``) and the rod model at the contact level
     ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N,
     ``bend_shift``: its sections centred on the bend's offset centreline, ``thinning``:
-    the stretch that thins them, :class:`~tightknot.contact.sectioned.SectionSettings`) and
+    the stretch that thins them, :class:`~tightknot.contact.sectioned.SectionSettings`;
+    ``rod_edges_per_d0``: the sectioned rod scenes' resolution, docs/sectioned_level.md,
+    "Resolution") and
     compare them; with ``soft``, also the two-soft-rod scenes soft_wrap and clasp
     (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, at every level of
     :data:`~tightknot.fem.rod_model_soft.CONTACT_LEVELS` in a compliant report, at the
@@ -370,6 +373,10 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
 
         # bad input first
         SectionSettings(max_mode=section_modes, bend_shift=bend_shift, thinning=thinning)
+        check_edges_per_d0(rod_edges_per_d0)
+    elif rod_edges_per_d0 != EDGES_PER_D0:
+        raise ValueError(f"rod_edges_per_d0 is a setting of the sectioned level's rod scenes "
+                         f"(contact sectioned), got contact {contact!r}")
     fem_results = dict(fem_results or {})
     start = time.perf_counter()
     if "indent" not in fem_results:
@@ -379,7 +386,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
     if contact == "sectioned":
         report = _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift,
-                                   thinning)
+                                   thinning, rod_edges_per_d0)
         if soft:
             from tightknot.contact.sectioned import SectionSettings
 
@@ -467,7 +474,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
 
 def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
                       section_modes: int, start: float, bend_shift: bool = False,
-                      thinning: str = "edge") -> dict[str, Any]:
+                      thinning: str = "edge", edges_per_d0: int = EDGES_PER_D0
+                      ) -> dict[str, Any]:
     """The cross-check of the sectioned level (:mod:`tightknot.fem.rod_sectioned`): force,
     A/A0, L_c and (wrap) curvature at every level, against the targets."""
     from tightknot.contact.sectioned import SectionSettings
@@ -478,8 +486,10 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
     t0 = time.perf_counter()
     rod_indent_sectioned([0.01 * ROD_DIAMETER], length_over_d0=1.5, section=section)
     warm = time.perf_counter() - t0
-    rod_ind = _rod_indent_like(fem_ind, rod_indent_sectioned, section=section)
-    rod_wr = _rod_wrap_like(fem_wrap, rod_wrap_sectioned, section=section)
+    rod_ind = _rod_indent_like(fem_ind, rod_indent_sectioned, section=section,
+                               edges_per_d0=edges_per_d0)
+    rod_wr = _rod_wrap_like(fem_wrap, rod_wrap_sectioned, section=section,
+                            edges_per_d0=edges_per_d0)
     fem_time = fem_ind["wall_time_s"] + fem_wrap["wall_time_s"]
     rod_time = rod_ind["wall_time_s"] + rod_wr["wall_time_s"]
     scenes = {
@@ -518,6 +528,7 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
         "section_modes": section_modes,
         "section_bend_shift": bend_shift,
         "section_thinning": thinning,
+        "rod_edges_per_d0": edges_per_d0,
         "penalty_over_e_per_d0": rod_ind["penalty"],
         "mesh": mesh,
         "approach_limit_over_d0": APPROACH_LIMIT,
