@@ -219,24 +219,35 @@ def test_section_energy_derivatives_match_finite_differences() -> None:
     assert np.max(np.abs(hv - g)) <= 1e-10 * np.max(np.abs(g))  # E = x^T H x / 2
 
 
-def test_the_level_in_a_rod_system_has_a_consistent_gradient_and_hessian() -> None:
-    # Two crossing rods pressed 0.01 D0 into each other, sections deformed at random.
-    d0 = 0.0085
+D0 = 0.0085  # [m]
+
+
+def _crossing_rods(gap: float, stretch: float, settings: SectionSettings
+                   ) -> tuple[RodSystem, SectionedLayer, np.random.Generator]:
+    """Two crossing 3 D0 rods with a sectioned level, their axes ``gap`` D0 apart, the
+    first one ``stretch`` times its rest length, positions jittered by 1e-4 D0."""
     mat = Material(1.25e6, 0.5, 1160.0)
     b = RodBuilder(twist=False)
-    z = np.linspace(-1.5 * d0, 1.5 * d0, 25)
-    b.add_rod(np.c_[np.zeros(25), np.zeros(25), z], d0, mat)
-    b.add_rod(np.c_[z, np.full(25, 0.99 * d0), np.zeros(25)], d0, mat)
+    z = np.linspace(-1.5 * D0, 1.5 * D0, 25)
+    b.add_rod(np.c_[np.zeros(25), np.zeros(25), z], D0, mat)
+    b.add_rod(np.c_[z, np.full(25, gap * D0), np.zeros(25)], D0, mat)
     model = b.finalize()
     rng = np.random.default_rng(0)
     state = State.initial(model)
-    state.x += 1e-4 * d0 * rng.normal(size=state.x.shape)
+    state.x[:25] *= np.array([1.0, 1.0, stretch])
+    state.x += 1e-4 * D0 * rng.normal(size=state.x.shape)
     system = RodSystem(model, state, BoundaryConditions(model))
-    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=32))
+    layer = SectionedLayer(model, settings)
     system.add_term(layer)
+    return system, layer, rng
+
+
+def test_the_level_in_a_rod_system_has_a_consistent_gradient_and_hessian() -> None:
+    # Two crossing rods pressed 0.01 D0 into each other, sections deformed at random.
+    system, _, rng = _crossing_rods(0.99, 1.0, SectionSettings(max_mode=6, samples=32))
     # the Hessian misses terms of relative order pen / R in the sections' blocks (measured
     # 7e-3 here, at a 0.01 D0 overlap of round sections)
-    check_derivatives(system, d0, rng)
+    check_derivatives(system, D0, rng)
 
 
 def test_sections_thinned_by_the_rods_mean_stretch_have_an_exact_gradient() -> None:
@@ -244,25 +255,13 @@ def test_sections_thinned_by_the_rods_mean_stretch_have_an_exact_gradient() -> N
     # whose chain rule through all the rod's edges is the host's (the kernel's dE/dlam;
     # here 19 % of the contact gradient's norm). The rods press 0.03 D0 into each other:
     # the first one's 5 % stretch thins its radius by 2.5 %.
-    d0 = 0.0085
-    mat = Material(1.25e6, 0.5, 1160.0)
-    b = RodBuilder(twist=False)
-    z = np.linspace(-1.5 * d0, 1.5 * d0, 25)
-    b.add_rod(np.c_[np.zeros(25), np.zeros(25), z], d0, mat)
-    b.add_rod(np.c_[z, np.full(25, 0.97 * d0), np.zeros(25)], d0, mat)
-    model = b.finalize()
-    rng = np.random.default_rng(0)
-    state = State.initial(model)
-    state.x[:25] *= np.array([1.0, 1.0, 1.05])  # the first rod 5 % longer than at rest
-    state.x += 1e-4 * d0 * rng.normal(size=state.x.shape)
-    system = RodSystem(model, state, BoundaryConditions(model))
-    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=32, thinning="rod"))
-    system.add_term(layer)
-    assert layer.rod_mean.rod_stretch(state.x, system.rest)[0] == pytest.approx(1.05,
-                                                                              rel=1e-3)
+    system, layer, rng = _crossing_rods(
+        0.97, 1.05, SectionSettings(max_mode=6, samples=32, thinning="rod"))
+    assert layer.rod_mean.rod_stretch(system.state.x, system.rest)[0] == pytest.approx(
+        1.05, rel=1e-3)
     # the Hessian with its dense part through the rods' lengths (central differences of
     # the kernel in each rod's stretch): measured 2e-5 relative here, 3e-4 without it
-    check_derivatives(system, d0, rng, hess_tol=1e-4)
+    check_derivatives(system, D0, rng, hess_tol=1e-4)
 
 
 def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator,

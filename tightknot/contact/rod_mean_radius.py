@@ -94,16 +94,35 @@ class RodMeanRadius:
                  e_r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The gradient term sum_r G_r grad s_r over vertex positions (V, 3) [N] and G per
         rod [J] (module docstring). ``pairs`` (P, 2) edges, ``e_r`` their E_R [J/m]."""
-        m = self.model
         fa, fb, _, _ = self._pair_rates(geo, pairs)
-        rod = m.edge_rod
+        rod = self.model.edge_rod
         big_g = (np.bincount(rod[pairs[:, 0]], e_r * fa, self.rod_count)
                  + np.bincount(rod[pairs[:, 1]], e_r * fb, self.rod_count))
-        f = (big_g / geo["L0"])[rod][:, None] * geo["t"]
+        return self.chain_gradient(geo, big_g), big_g
+
+    def chain_gradient(self, geo: dict[str, np.ndarray], big_g: np.ndarray) -> np.ndarray:
+        """sum_r G_r grad s_r over vertex positions (V, 3) [N] for G [J] per rod, grad s_r
+        = (1/L0_r) sum_e dl_e/dx (dl/dx = -+ t at an edge's ends)."""
+        m = self.model
+        f = (big_g / geo["L0"])[m.edge_rod][:, None] * geo["t"]
         g = np.zeros((m.vertex_count, 3))
         np.add.at(g, m.edge_vertex[:, 1], f)
         np.add.at(g, m.edge_vertex[:, 0], -f)
-        return g, big_g
+        return g
+
+    def stretch_columns(self, geo: dict[str, np.ndarray], rods: np.ndarray, first: int = 0,
+                        end: int | None = None) -> np.ndarray:
+        """grad s_r of each rod in ``rods`` as columns over the dofs ``first`` to ``end``
+        (default: all the model's), (end - first, k) [1/m]."""
+        end = self.model.dof_count if end is None else end
+        u = np.zeros((end - first, len(rods)))
+        for j, r in enumerate(rods):
+            edges = self.model.rods[int(r)].edge_slice
+            t = geo["t"][edges] / geo["L0"][r]
+            ed = self.edge_dofs[edges] - first
+            np.add.at(u[:, j], ed[:, 3:].ravel(), t.ravel())
+            np.add.at(u[:, j], ed[:, :3].ravel(), -t.ravel())
+        return u
 
     def stretch_blocks(self, geo: dict[str, np.ndarray], big_g: np.ndarray
                        ) -> np.ndarray:
@@ -142,12 +161,8 @@ class RodMeanRadius:
         s_mat[np.diag_indices(k)] += curv
         first, end = (0, m.dof_count) if dofs is None else dofs
         u = np.zeros((end - first, 2 * k))
-        for j, r in enumerate(rods):
-            edges = m.rods[int(r)].edge_slice
-            t = geo["t"][edges] / geo["L0"][r]
-            ed = self.edge_dofs[edges] - first
-            np.add.at(u[:, j], ed[:, 3:].ravel(), t.ravel())
-            np.add.at(u[:, j], ed[:, :3].ravel(), -t.ravel())
+        u[:, :k] = self.stretch_columns(geo, rods, first, end)
+        for j in range(k):
             np.add.at(u[:, k + j], (pair_dofs - first).ravel(),
                       (g_r * rate[:, j:j + 1]).ravel())
         c = np.zeros((2 * k, 2 * k))

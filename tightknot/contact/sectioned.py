@@ -505,43 +505,30 @@ class SectionedLayer(ContactLayer):
                 self._in_twist.put(self.end_twist(m_ref)), self._in_rest.put(rest), arcs,
                 rod_len, self._in_lam.put(lam)]
 
-    def _rod_mean_gradient(self, x: np.ndarray, rest: np.ndarray, pairs: np.ndarray,
-                           dlam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The gradient over positions (V, 3) [N] that the contact energy has through its
-        rods' mean stretches s_r = L_r / L0_r (``thinning="rod"``): sum_r G_r grad s_r,
-        G_r the passes' dE/dlam (``dlam``, (2 P, 2): each pass's A and B side) summed over
-        the rods, grad s_r = (1/L0_r) sum_e dl_e/dx (Bergou et al. 2008 stretching: dl/dx
-        = -+ t at an edge's ends); and G_r [J] per rod."""
-        m = self.model
-        ev = self._ev
-        nrod = len(m.rods)
+    def _rod_sums(self, pairs: np.ndarray, dlam: np.ndarray) -> np.ndarray:
+        """G_r = dE/ds_r [J] per rod: the passes' dE/dlam (``dlam``, (2 P, 2): each pass's
+        A and B side, pass 2p taking ``pairs[p]`` as (A, B) and 2p + 1 as (B, A)) summed
+        over the rods of their edges."""
+        nrod = len(self.model.rods)
+        rod_of = np.asarray(self.model.edge_rod, dtype=np.int64)
         order = np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)  # pass: A, B
-        rod_of = np.asarray(m.edge_rod, dtype=np.int64)
-        big_g = (np.bincount(rod_of[order[:, 0]], dlam[:, 0], nrod)
-                 + np.bincount(rod_of[order[:, 1]], dlam[:, 1], nrod))
-        rest_len = np.bincount(rod_of, rest, nrod)
-        e = x[ev[:, 1]] - x[ev[:, 0]]
-        t = e / np.linalg.norm(e, axis=1)[:, None]
-        w = (big_g / rest_len)[rod_of][:, None] * t
-        g = np.zeros((m.vertex_count, 3))
-        np.add.at(g, ev[:, 1], w)
-        np.add.at(g, ev[:, 0], -w)
-        return g, big_g
+        return (np.bincount(rod_of[order[:, 0]], dlam[:, 0], nrod)
+                + np.bincount(rod_of[order[:, 1]], dlam[:, 1], nrod))
 
-    def _rod_mean_low_rank(self, wx: wp.array, wp_act: wp.array, data: list[wp.array],
-                           slots: np.ndarray, block_count: int, act_pairs: np.ndarray,
-                           dofs: np.ndarray, x: np.ndarray, rest: np.ndarray
+    def _rod_mean_low_rank(self, geo: dict[str, np.ndarray], wx: wp.array, wp_act: wp.array,
+                           data: list[wp.array], slots: np.ndarray, block_count: int,
+                           act_pairs: np.ndarray, dofs: np.ndarray
                            ) -> tuple[np.ndarray, np.ndarray]:
         """The dense part of the Hessian through the rods' mean stretches s_r
-        (``thinning="rod"``; the chain rule of :mod:`tightknot.contact.rod_mean_radius`):
+        (``thinning="rod"``; the chain rule of :mod:`tightknot.contact.rod_mean_radius`,
+        ``geo`` its :meth:`~tightknot.contact.rod_mean_radius.RodMeanRadius.radii`):
         U C U^T with U = [grad s_r .., w_r ..] over the extended dofs and C = [[S, I], [I,
         0]], w_r = d(grad E)/ds_r at fixed dofs and S_rq = d^2 E / ds_r ds_q. Both come from
         central differences of the derivative kernel in each deformable rod's stretch
         (step 1e-6: truncation 1e-12, round-off 1e-10 of the entries)."""
         m = self.model
-        nrod = len(m.rods)
         rod_of = np.asarray(m.edge_rod, dtype=np.int64)
-        lam = self.rod_mean.stretch(x, rest)
+        lam = geo["s"][rod_of]
         rods = sorted({int(r) for r in rod_of[act_pairs.ravel()]
                        if not self.edge_rigid[m.rods[int(r)].edge_slice.start]})
         ext = m.dof_count + self.dof_count
@@ -558,54 +545,34 @@ class SectionedLayer(ContactLayer):
                                    slots=slots, block_count=block_count)
                 # the gradient at fixed stretch (the chain term G grad s is not in w)
                 full = np.bincount(dofs[keep], weights=out["grad"][keep], minlength=ext)
-                order = np.stack([act_pairs, act_pairs[:, ::-1]], axis=1).reshape(-1, 2)
-                big_g = (np.bincount(rod_of[order[:, 0]], out["dlam"][:, 0], nrod)
-                         + np.bincount(rod_of[order[:, 1]], out["dlam"][:, 1], nrod))
-                sides.append((full, big_g))
+                sides.append((full, self._rod_sums(act_pairs, out["dlam"])))
             w_cols.append((sides[0][0] - sides[1][0]) / (2.0 * eps))
             s_cols.append((sides[0][1] - sides[1][1]) / (2.0 * eps))
         k = len(rods)
         s_mat = np.array([[s_cols[j][rods[i]] for j in range(k)] for i in range(k)])
         s_mat = 0.5 * (s_mat + s_mat.T)
-        ev = self._ev
-        rest_len = np.bincount(rod_of, rest, nrod)
-        e = x[ev[:, 1]] - x[ev[:, 0]]
-        t = e / np.linalg.norm(e, axis=1)[:, None]
-        grads = []
-        for r in rods:
-            g = np.zeros((m.vertex_count, 3))
-            mine = rod_of == r
-            np.add.at(g, ev[mine, 1], t[mine] / rest_len[r])
-            np.add.at(g, ev[mine, 0], -t[mine] / rest_len[r])
-            col = np.zeros(ext)
-            col[m.position_dofs] = g
-            grads.append(col)
-        u = np.column_stack(grads + w_cols)
+        grads = np.zeros((ext, k))
+        grads[:m.dof_count] = self.rod_mean.stretch_columns(geo, np.array(rods))
+        u = np.column_stack([grads, *w_cols])
         c = np.block([[s_mat, np.eye(k)], [np.eye(k), np.zeros((k, k))]])
         return u, c
 
-    def _add_stretch_blocks(self, hess: BlockHessian, x: np.ndarray, rest: np.ndarray,
+    def _add_stretch_blocks(self, hess: BlockHessian, geo: dict[str, np.ndarray],
                             big_g: np.ndarray) -> None:
-        """Add sum_r G_r Hess s_r to ``hess``'s position blocks (``thinning="rod"``):
-        Hess s_r = (1/L0_r) sum_e [[P, -P], [-P, P]] / l_e over the rod's edges, P = I - t
-        t^T (the second derivative of an edge's length). Only the deformable edges' rods
-        have G_r != 0 (a rigid section does not thin), and their end pairs are among the
-        blocks (the section energy's)."""
-        m = self.model
+        """Add sum_r G_r Hess s_r (:meth:`~tightknot.contact.rod_mean_radius.RodMeanRadius.
+        stretch_blocks`, one 6 x 6 block per edge) to ``hess``'s position blocks
+        (``thinning="rod"``). Only the deformable edges' rods have G_r != 0 (a rigid
+        section does not thin), and their end pairs are among the blocks (the section
+        energy's)."""
+        nodes = self.model.vertex_count
         ev = self._ev[self._section_edges]
-        rod_of = np.asarray(m.edge_rod, dtype=np.int64)
-        nrod = len(m.rods)
-        rest_len = np.bincount(rod_of, rest, nrod)
-        e = x[ev[:, 1]] - x[ev[:, 0]]
-        length = np.linalg.norm(e, axis=1)
-        t = e / length[:, None]
-        coef = (big_g / rest_len)[rod_of[self._section_edges]] / length
-        blk = coef[:, None, None] * (np.eye(3)[None] - t[:, :, None] * t[:, None, :])
-        nodes = m.vertex_count
+        blk = self.rod_mean.stretch_blocks(geo, big_g)[self._section_edges]
         hk = hess.keys[:, 0] * nodes + hess.keys[:, 1]
-        for (r, c), sign in (((0, 0), 1.0), ((1, 1), 1.0), ((0, 1), -1.0), ((1, 0), -1.0)):
-            slot = np.searchsorted(hk, ev[:, r] * nodes + ev[:, c])
-            np.add.at(hess.blocks[:, :3, :3], slot, sign * blk)
+        for r in range(2):
+            for c in range(2):
+                slot = np.searchsorted(hk, ev[:, r] * nodes + ev[:, c])
+                np.add.at(hess.blocks[:, :3, :3], slot,
+                          blk[:, 3 * r:3 * r + 3, 3 * c:3 * c + 3])
 
     def _pass_dofs(self, pairs: np.ndarray) -> np.ndarray:
         """Extended dofs (model dofs, then model.dof_count + the term's) of each pass's
@@ -675,20 +642,22 @@ class SectionedLayer(ContactLayer):
         full = np.bincount(dofs[keep], weights=out["grad"][keep],
                            minlength=m.dof_count + self.dof_count)
         g_x = full[m.position_dofs]
-        big_g = None
+        geo = big_g = None
         if self.rod_mean is not None:
-            g_mean, big_g = self._rod_mean_gradient(x, rest, act_pairs, out["dlam"])
-            g_x = g_x + g_mean
+            # the chain rule through the rods' mean stretches (rod_mean_radius)
+            geo = self.rod_mean.radii(x, rest)
+            big_g = self._rod_sums(act_pairs, out["dlam"])
+            g_x = g_x + self.rod_mean.chain_gradient(geo, big_g)
         g_c = full[m.dof_count:]
         hess = None
         if want_hess:
             hess = BlockHessian(self._node_dofs,
                                 np.stack([keys // m.vertex_count, keys % m.vertex_count], axis=1),
                                 out["blocks"])
-            if big_g is not None:
-                self._add_stretch_blocks(hess, x, rest, big_g)
-                hess.low_rank = self._rod_mean_low_rank(wx, wp_act, data, slots, keys.size,
-                                                        act_pairs, dofs, x, rest)
+            if geo is not None:
+                self._add_stretch_blocks(hess, geo, big_g)
+                hess.low_rank = self._rod_mean_low_rank(geo, wx, wp_act, data, slots,
+                                                        keys.size, act_pairs, dofs)
         if shifted is not None:
             # derivatives over the offset centreline carried to the centreline
             if hess is not None:

@@ -30,13 +30,13 @@ DENSITY: float = 1160.0
 """Density [kg/m^3] of the rod model's material (statics: it plays no role)."""
 
 
-
 def check_edges_per_d0(edges_per_d0: object) -> None:
     """Refuse a rod resolution that is not an integer of at least 4 edges per D0 (fewer
     cannot follow a crossing's dent, about a diameter long)."""
     if (isinstance(edges_per_d0, bool) or not isinstance(edges_per_d0, (int, np.integer))
             or edges_per_d0 < 4):
         raise ValueError(f"edges_per_d0 must be an integer >= 4, got {edges_per_d0!r}")
+
 
 def rigid_counterbody_law(law: Any) -> Any:
     """The pair law of a rod against a rigid body of the same diameter: k 2^p for the line
