@@ -110,12 +110,14 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
         return wp.array(np.asarray(x), dtype=dt)
 
     nl = 12 + 4 * K
+    phi = 2.0 * np.pi * (np.arange(32) + 0.5) / 32
     offs = [0, K, -1 if rigid_b else 2 * K, -1 if rigid_b else 3 * K]
     model = [arr([[0, 1], [2, 3]], wp.vec2i), arr([0, 1], wp.int32), arr([0, 0], wp.int32),
              arr([0.5, 0.5], f), arr([0.5, 0.5], f), arr([1.0, 1.0], f),
              arr([0, int(rigid_b)], wp.int32), arr(offs, wp.int32),
              arr([[0, 0], [0, 0]], wp.vec2i), arr([0.0, 0.0], f), arr(GAUSS[0], f),
-             arr(GAUSS[1], f), K, 32, 1000.0, 1e-4, 0]
+             arr(GAUSS[1], f), arr(np.cos(phi), f), arr(np.sin(phi), f), K, 32, 1000.0,
+             1e-4, 0]
     data = [arr(np.array([a.x0, a.x1, b.x0, b.x1]), wp.vec3d),
             arr(np.concatenate([a.coeffs0, a.coeffs1, b.coeffs0, b.coeffs1]), f),
             arr([a.t_ref, b.t_ref], wp.vec3d), arr([a.d1_ref, b.d1_ref], wp.vec3d),

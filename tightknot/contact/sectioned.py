@@ -290,6 +290,11 @@ class SectionedLayer(ContactLayer):
                 ends[rod.edge_slice.start, 0] = 1
                 ends[rod.edge_slice.stop - 1, 1] = 1
         g_xi, g_w = self.settings.gauss
+        samples = int(self.section.samples)
+        sample_cos = wp.zeros(samples, dtype=f64, device=dev)
+        sample_sin = wp.zeros(samples, dtype=f64, device=dev)
+        wp.launch(sk.sample_directions, samples, [samples], [sample_cos, sample_sin],
+                  device=dev)
         self._model_args = [
             self.broad_phase.edge_vertex, self.broad_phase.edge_rod,
             self.broad_phase.rod_closed,
@@ -301,7 +306,7 @@ class SectionedLayer(ContactLayer):
             wp.array(ends, dtype=wp.vec2i, device=dev),
             self.broad_phase.edge_exclusion,
             wp.array(g_xi, dtype=f64, device=dev), wp.array(g_w, dtype=f64, device=dev),
-            k, int(self.section.samples), float(self.penalty), float(self.section.onset),
+            sample_cos, sample_sin, k, samples, float(self.penalty), float(self.section.onset),
             int(self.section.thinning == "rod"),
         ]
         #: Each rod's mean stretch (the sections' thinning with ``thinning="rod"``).

@@ -144,9 +144,14 @@ def rounded_penalty(pen: wp.float64, kappa: wp.float64, onset: wp.float64) -> wp
 @wp.func
 def mode_basis(phi: wp.float64, k: int):
     """B(phi) and B'(phi) of the coefficients (a_2, b_2, ..., a_N, b_N), k = 2 (N - 1): cos n
-    phi, sin n phi and their derivatives, by the angle-addition recurrence."""
-    c1 = wp.cos(phi)
-    s1 = wp.sin(phi)
+    phi, sin n phi and their derivatives (:func:`mode_basis_cs`)."""
+    return mode_basis_cs(wp.cos(phi), wp.sin(phi), k)
+
+
+@wp.func
+def mode_basis_cs(c1: wp.float64, s1: wp.float64, k: int):
+    """:func:`mode_basis` at the angle of cosine ``c1`` and sine ``s1``, by the
+    angle-addition recurrence."""
     cn = c1 * c1 - s1 * s1  # n = 2
     sn = f64(2.0) * s1 * c1
     b = vecKd()
@@ -174,18 +179,29 @@ def load_section(coeff: wp.array(dtype=wp.float64), off: int, k: int) -> vecKd:
 
 
 @wp.func
-def rotate_modes(c: vecKd, angle: wp.float64, k: int, transpose: int) -> vecKd:
-    """Q(angle) c, or Q^T c (transpose != 0): mode n turned by n angle
-    (sectioned_reference.mode_rotation)."""
-    out = vecKd()
+def mode_turn(angle: wp.float64, k: int):
+    """cos n angle and sin n angle of the modes n = 2 .. N (entries 0 .. k/2 - 1): a turn
+    that several coefficient vectors share (:func:`turn_modes`)."""
+    cs = vecKd()
+    sn = vecKd()
     for j in range(k // 2):
         n = f64(2 + j)
-        cs = wp.cos(n * angle)
-        sn = wp.sin(n * angle)
+        cs[j] = wp.cos(n * angle)
+        sn[j] = wp.sin(n * angle)
+    return cs, sn
+
+
+@wp.func
+def turn_modes(c: vecKd, cs: vecKd, sn: vecKd, k: int, transpose: int) -> vecKd:
+    """Q c, or Q^T c (transpose != 0), with Q's cosines and sines ``cs``, ``sn``
+    (:func:`mode_turn`)."""
+    out = vecKd()
+    for j in range(k // 2):
+        s_j = sn[j]
         if transpose != 0:
-            sn = -sn
-        out[2 * j] = cs * c[2 * j] + sn * c[2 * j + 1]
-        out[2 * j + 1] = -sn * c[2 * j] + cs * c[2 * j + 1]
+            s_j = -s_j
+        out[2 * j] = cs[j] * c[2 * j] + s_j * c[2 * j + 1]
+        out[2 * j + 1] = -s_j * c[2 * j] + cs[j] * c[2 * j + 1]
     return out
 
 
@@ -399,21 +415,31 @@ def cylinder(w: wp.vec3d, e: wp.vec3d, fd: FrameDerivatives) -> Cylinder:
 
 
 @wp.func
-def radius_partials(c: vecKd, k: int, rigid: int, r0: wp.float64, nu: wp.float64,
-                    lam: wp.float64):
-    """R, dR/dlam and d2R/dlam2 where the coefficients are c (r0, 0, 0 for a rigid
-    section; R = -1 where it is not real)."""
+def radius_base(r0: wp.float64, nu: wp.float64, lam: wp.float64) -> wp.vec3d:
+    """r0^2 lam^(-2 nu) [m^2] and its first two derivatives in lam: the mean radius's
+    parts that depend on the stretch alone (a pass's constants, :func:`radius_partials`)."""
+    s0 = r0 * r0 * wp.pow(lam, f64(-2.0) * nu)
+    s1 = f64(-2.0) * nu * r0 * r0 * wp.pow(lam, f64(-2.0) * nu - f64(1.0))
+    s2 = f64(2.0) * nu * (f64(2.0) * nu + f64(1.0)) * r0 * r0 * wp.pow(lam, f64(-2.0) * nu
+                                                                      - f64(2.0))
+    return wp.vec3d(s0, s1, s2)
+
+
+@wp.func
+def radius_partials(c: vecKd, k: int, rigid: int, r0: wp.float64, base: wp.vec3d):
+    """R, dR/dlam and d2R/dlam2 where the coefficients are c and the stretch's part is
+    ``base`` (:func:`radius_base`): R^2 = r0^2 lam^(-2 nu) - |c|^2 / 2 (r0, 0, 0 for a
+    rigid section; R = -1 where it is not real)."""
     if rigid != 0:
         return r0, f64(0.0), f64(0.0)
-    s = r0 * r0 * wp.pow(lam, f64(-2.0) * nu)
+    s = base[0]
     for j in range(k):
         s -= f64(0.5) * c[j] * c[j]
     if s <= f64(0.0):
         return f64(-1.0), f64(0.0), f64(0.0)
     big_r = wp.sqrt(s)
-    s1 = f64(-2.0) * nu * r0 * r0 * wp.pow(lam, f64(-2.0) * nu - f64(1.0))
-    s2 = f64(2.0) * nu * (f64(2.0) * nu + f64(1.0)) * r0 * r0 * wp.pow(lam, f64(-2.0) * nu
-                                                                      - f64(2.0))
+    s1 = base[1]
+    s2 = base[2]
     return big_r, s1 / (f64(2.0) * big_r), (s2 / (f64(2.0) * big_r)
                                             - s1 * s1 / (f64(4.0) * big_r * big_r * big_r))
 
@@ -455,6 +481,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         edge_exclusion: wp.array(dtype=wp.float64),
         gauss_xi: wp.array(dtype=wp.float64),
         gauss_w: wp.array(dtype=wp.float64),
+        sample_cos: wp.array(dtype=wp.float64),
+        sample_sin: wp.array(dtype=wp.float64),
         coeff_count: int,
         samples: int,
         penalty: wp.float64,
@@ -527,20 +555,25 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         # move the boundary by at most their amplitudes' sum (turning keeps each mode's
         # amplitude), and over the partner's reach (v in [-1/2, 3/2]) the interpolation
         # weighs the two vertices by at most 1.5 each.
-        r_a_max = edge_r0[ea] * wp.pow(lam_a, -edge_nu[ea]) + wp.max(amplitude_sum(ca0, k),
-                                                                     amplitude_sum(ca1, k))
+        amp_a = wp.max(amplitude_sum(ca0, k), amplitude_sum(ca1, k))
+        r_a_max = edge_r0[ea] * wp.pow(lam_a, -edge_nu[ea]) + amp_a
         r_b_max = edge_r0[eb] * wp.pow(lam_b, -edge_nu[eb]) + f64(1.5) * (
             amplitude_sum(cb0, k) + amplitude_sum(cb1, k))
         if rig_a != 0:
             r_a_max = edge_r0[ea]
+            amp_a = f64(0.0)
         if rig_b != 0:
             r_b_max = edge_r0[eb]
         if segment_line_distance(xa0, x_in[va[1]], xb0, vec_b) > r_a_max + r_b_max:
             energy_out[tid] = energy
             pen_max_out[tid] = pen_max
             return
-        ca1 = rotate_modes(ca1, end_twist_in[ea], k, 1)
-        cb1 = rotate_modes(cb1, end_twist_in[eb], k, 1)
+        turn_ac, turn_as = mode_turn(end_twist_in[ea], k)
+        turn_bc, turn_bs = mode_turn(end_twist_in[eb], k)
+        ca1 = turn_modes(ca1, turn_ac, turn_as, k, 1)
+        cb1 = turn_modes(cb1, turn_bc, turn_bs, k, 1)
+        base_a = radius_base(edge_r0[ea], edge_nu[ea], lam_a)
+        base_b = radius_base(edge_r0[eb], edge_nu[eb], lam_b)
         if wp.static(derivatives):
             fa = frame_derivatives(d1_ref_in[ea], t_ref_in[ea], vec_a)
             fb = frame_derivatives(d1_ref_in[eb], t_ref_in[eb], vec_b)
@@ -569,8 +602,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         endb = edge_end[eb]
         area = rest_in[ea] * edge_r0[ea] * f64(TWO_PI) / f64(samples)
         dcb = cb1 - cb0  # dc_b/dv
-        mta = end_twist_in[ea]
-        mtb = end_twist_in[eb]
         go = tid * nl
         touched = int(0)
         dlam_a = f64(0.0)
@@ -605,22 +636,31 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             if wp.length(rel0 - v0c * vec_b) > r_a_max + r_b_max:
                 continue
             ca = (f64(1.0) - u) * ca0 + u * ca1
-            ra_mean, ra_l, ra_ll = radius_partials(ca, k, rig_a, edge_r0[ea], edge_nu[ea],
-                                                   lam_a)
+            ra_mean, ra_l, ra_ll = radius_partials(ca, k, rig_a, edge_r0[ea], base_a)
             if ra_mean <= f64(0.0):
                 energy_out[tid] = f64(1.0e300)
                 pen_max_out[tid] = pen_max
                 return
             s_a = arc_a[0] + u * (arc_a[1] - arc_a[0])
             for kk in range(samples):
-                phi = f64(TWO_PI) * (f64(kk) + f64(0.5)) / f64(samples)
-                cphi = wp.cos(phi)
-                sphi = wp.sin(phi)
-                bphi, bphi1 = mode_basis(phi, k)
+                cphi = sample_cos[kk]
+                sphi = sample_sin[kk]
+                dirv = cphi * d1a + sphi * d2a
+                if rig_a == 0:
+                    # The modes move the sample by at most amp_a from the mean circle's
+                    # point q, so q shows (with a margin for round-off) the samples that
+                    # the tests below would skip, before the modes are summed.
+                    slack = amp_a * f64(1.000001) + f64(1.0e-9) * (r_a_max + r_b_max)
+                    relq = xu + ra_mean * dirv - xb0
+                    vq = wp.dot(relq, vec_b) / (lb * lb)
+                    if vq < f64(-0.5) - slack / lb or vq > f64(1.5) + slack / lb:
+                        continue
+                    if wp.length(relq - vq * vec_b) - slack >= r_b_max:
+                        continue
+                bphi, bphi1 = mode_basis_cs(cphi, sphi, k)
                 r_a = ra_mean
                 if rig_a == 0:
                     r_a += wp.dot(bphi, ca)
-                dirv = cphi * d1a + sphi * d2a
                 p = xu + r_a * dirv
                 rel = p - xb0
                 v = wp.dot(rel, vec_b) / (lb * lb)
@@ -635,8 +675,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 psi = wp.atan2(by, bx)
                 bpsi, bpsi1 = mode_basis(psi, k)
                 cb = (f64(1.0) - v) * cb0 + v * cb1
-                rb_mean, rb_l, rb_ll = radius_partials(cb, k, rig_b, edge_r0[eb], edge_nu[eb],
-                                                       lam_b)
+                rb_mean, rb_l, rb_ll = radius_partials(cb, k, rig_b, edge_r0[eb], base_b)
                 if rb_mean <= f64(0.0):
                     energy_out[tid] = f64(1.0e300)
                     pen_max_out[tid] = pen_max
@@ -761,9 +800,9 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     # directions to the pass's dofs (the section directions: alpha by
                     # (1 - u) and u Q to A's vertices, beta and gamma by (1 - v) and v Q,
                     # delta by -1 and Q to B's), added to the registers above.
-                    qa = rotate_modes(ba, mta, k, 0)
-                    qb = rotate_modes(bb, mtb, k, 0)
-                    qs = rotate_modes(bpsi1, mtb, k, 0)
+                    qa = turn_modes(ba, turn_ac, turn_as, k, 0)
+                    qb = turn_modes(bb, turn_bc, turn_bs, k, 0)
+                    qs = turn_modes(bpsi1, turn_bc, turn_bs, k, 0)
                     one_u = f64(1.0) - u
                     one_v = f64(1.0) - v
                     wa0 = one_u * ba
@@ -940,6 +979,17 @@ def scatter_coeff(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp.i
             val = hc[i, j]
             wp.atomic_add(blocks, base + (3 + i) * bsz + 3 + j, val)
             wp.atomic_add(blocks, base_t + (3 + j) * bsz + 3 + i, val)
+
+
+@wp.kernel
+def sample_directions(samples: int, cos_out: wp.array(dtype=wp.float64),
+                      sin_out: wp.array(dtype=wp.float64)):
+    """cos and sin of the boundary samples' angles phi_k = 2 pi (k + 1/2) / M (the pass
+    kernels read them, so that each pass does not evaluate them again)."""
+    kk = wp.tid()
+    phi = f64(TWO_PI) * (f64(kk) + f64(0.5)) / f64(samples)
+    cos_out[kk] = wp.cos(phi)
+    sin_out[kk] = wp.sin(phi)
 
 
 #: The variants: energy only, energy with derivatives, energy with the samples' report.
