@@ -118,11 +118,16 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
              arr([[0, 0], [0, 0]], wp.vec2i), arr([0.0, 0.0], f), arr(GAUSS[0], f),
              arr(GAUSS[1], f), arr(np.cos(phi), f), arr(np.sin(phi), f), K, 32, 1000.0,
              1e-4, 0]
-    data = [arr(np.array([a.x0, a.x1, b.x0, b.x1]), wp.vec3d),
-            arr(np.concatenate([a.coeffs0, a.coeffs1, b.coeffs0, b.coeffs1]), f),
+    x = arr(np.array([a.x0, a.x1, b.x0, b.x1]), wp.vec3d)
+    coeff = arr(np.concatenate([a.coeffs0, a.coeffs1, b.coeffs0, b.coeffs1]), f)
+    rest, lam = arr([a.rest, b.rest], f), arr([1.0], f)
+    bounds = [wp.zeros(4, dtype=f), wp.zeros(2, dtype=f)]  # per vertex, per edge
+    wp.launch(sk.section_bounds, 6, [model[0], model[7], model[3], model[4], model[6], K, 0,
+                                     x, coeff, rest, lam], bounds)
+    data = [x, coeff,
             arr([a.t_ref, b.t_ref], wp.vec3d), arr([a.d1_ref, b.d1_ref], wp.vec3d),
-            arr([a.twist1, b.twist1], f), arr([a.rest, b.rest], f),
-            arr([a.arc, b.arc], wp.vec2d), arr([1.0, 1.0], f), arr([1.0], f),
+            arr([a.twist1, b.twist1], f), rest,
+            arr([a.arc, b.arc], wp.vec2d), arr([1.0, 1.0], f), lam, *bounds,
             arr([[0, 1]], wp.vec2i), arr(np.arange(16), wp.int32)]
     bsz = 3 + K
     outs = [wp.zeros(2, dtype=f), wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),

@@ -295,20 +295,26 @@ class SectionedLayer(ContactLayer):
         sample_sin = wp.zeros(samples, dtype=f64, device=dev)
         wp.launch(sk.sample_directions, samples, [samples], [sample_cos, sample_sin],
                   device=dev)
+        edge_r0 = wp.array(self.edge_r0, dtype=f64, device=dev)
+        edge_nu = wp.array(self.edge_nu, dtype=f64, device=dev)
+        edge_rigid = wp.array(self.edge_rigid.astype(np.int32), dtype=wp.int32, device=dev)
+        vertex_offset = wp.array(offset.astype(np.int32), dtype=wp.int32, device=dev)
+        rod_mean = int(self.section.thinning == "rod")
         self._model_args = [
             self.broad_phase.edge_vertex, self.broad_phase.edge_rod,
-            self.broad_phase.rod_closed,
-            wp.array(self.edge_r0, dtype=f64, device=dev),
-            wp.array(self.edge_nu, dtype=f64, device=dev),
-            wp.array(self.edge_modulus, dtype=f64, device=dev),
-            wp.array(self.edge_rigid.astype(np.int32), dtype=wp.int32, device=dev),
-            wp.array(offset.astype(np.int32), dtype=wp.int32, device=dev),
+            self.broad_phase.rod_closed, edge_r0, edge_nu,
+            wp.array(self.edge_modulus, dtype=f64, device=dev), edge_rigid, vertex_offset,
             wp.array(ends, dtype=wp.vec2i, device=dev),
             self.broad_phase.edge_exclusion,
             wp.array(g_xi, dtype=f64, device=dev), wp.array(g_w, dtype=f64, device=dev),
             sample_cos, sample_sin, k, samples, float(self.penalty), float(self.section.onset),
-            int(self.section.thinning == "rod"),
+            rod_mean,
         ]
+        # the inputs of sk.section_bounds before the state's, and its outputs
+        self._bounds_args = [self.broad_phase.edge_vertex, vertex_offset, edge_r0, edge_nu,
+                             edge_rigid, k, rod_mean]
+        self._vertex_amp = wp.zeros(m.vertex_count, dtype=f64, device=dev)
+        self._edge_rbase = wp.zeros(m.edge_count, dtype=f64, device=dev)
         #: Each rod's mean stretch (the sections' thinning with ``thinning="rod"``).
         self.rod_mean = (RodMeanRadius(m, self.edge_nu) if self.section.thinning == "rod"
                          else None)
@@ -484,8 +490,13 @@ class SectionedLayer(ContactLayer):
         s_wt = wp.zeros(ns, dtype=f64, device=dev)
         with_lam = derivatives and self.rod_mean is not None
         dlam = wp.zeros(2 * threads if with_lam else 1, dtype=f64, device=dev)
-        wp.launch(kernel, threads, [*self._model_args, wx, *data,
-                                    self.broad_phase.buffer_of(pairs), w_slots],
+        coeff, rest, lam = data[0], data[4], data[-1]
+        nv, ne = self.model.vertex_count, self.model.edge_count
+        wp.launch(sk.section_bounds, nv + ne, [*self._bounds_args, wx, coeff, rest, lam],
+                  [self._vertex_amp, self._edge_rbase], device=dev)
+        wp.launch(kernel, threads, [*self._model_args, wx, *data, self._vertex_amp,
+                                    self._edge_rbase, self.broad_phase.buffer_of(pairs),
+                                    w_slots],
                   [energy, pen_max, grad, blocks, s_pen, s_wt, dlam], device=dev)
         out = {"energy": energy.numpy(), "pen_max": pen_max.numpy()}
         if derivatives:

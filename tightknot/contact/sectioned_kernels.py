@@ -498,6 +498,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         arc_in: wp.array(dtype=wp.vec2d),
         rod_length_in: wp.array(dtype=wp.float64),
         lam_in: wp.array(dtype=wp.float64),
+        vertex_amp_in: wp.array(dtype=wp.float64),
+        edge_rbase_in: wp.array(dtype=wp.float64),
         pairs_in: wp.array(dtype=wp.vec2i),
         slots_in: wp.array(dtype=wp.int32),
         # Out:
@@ -538,12 +540,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         tb = vec_b / lb
         rig_a = edge_rigid[ea]
         rig_b = edge_rigid[eb]
-        # The sections of the edges' vertices (the second one's turned into the edge's
-        # frame below, once the pass is known to reach).
-        ca0 = load_section(coeff_in, vertex_offset[va[0]], k)
-        ca1 = load_section(coeff_in, vertex_offset[va[1]], k)
-        cb0 = load_section(coeff_in, vertex_offset[vb[0]], k)
-        cb1 = load_section(coeff_in, vertex_offset[vb[1]], k)
         lam_a = la / rest_in[ea]
         lam_b = lb / rest_in[eb]
         if rod_mean != 0:
@@ -554,11 +550,10 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         # Largest boundary radii: the mean radius is at most r0 lam^-nu, a vertex's modes
         # move the boundary by at most their amplitudes' sum (turning keeps each mode's
         # amplitude), and over the partner's reach (v in [-1/2, 3/2]) the interpolation
-        # weighs the two vertices by at most 1.5 each.
-        amp_a = wp.max(amplitude_sum(ca0, k), amplitude_sum(ca1, k))
-        r_a_max = edge_r0[ea] * wp.pow(lam_a, -edge_nu[ea]) + amp_a
-        r_b_max = edge_r0[eb] * wp.pow(lam_b, -edge_nu[eb]) + f64(1.5) * (
-            amplitude_sum(cb0, k) + amplitude_sum(cb1, k))
+        # weighs the two vertices by at most 1.5 each (:func:`section_bounds`).
+        amp_a = wp.max(vertex_amp_in[va[0]], vertex_amp_in[va[1]])
+        r_a_max = edge_rbase_in[ea] + amp_a
+        r_b_max = edge_rbase_in[eb] + f64(1.5) * (vertex_amp_in[vb[0]] + vertex_amp_in[vb[1]])
         if rig_a != 0:
             r_a_max = edge_r0[ea]
             amp_a = f64(0.0)
@@ -568,6 +563,12 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             energy_out[tid] = energy
             pen_max_out[tid] = pen_max
             return
+        # The sections of the edges' vertices, the second one's turned into the edge's
+        # frame.
+        ca0 = load_section(coeff_in, vertex_offset[va[0]], k)
+        ca1 = load_section(coeff_in, vertex_offset[va[1]], k)
+        cb0 = load_section(coeff_in, vertex_offset[vb[0]], k)
+        cb1 = load_section(coeff_in, vertex_offset[vb[1]], k)
         turn_ac, turn_as = mode_turn(end_twist_in[ea], k)
         turn_bc, turn_bs = mode_turn(end_twist_in[eb], k)
         ca1 = turn_modes(ca1, turn_ac, turn_as, k, 1)
@@ -979,6 +980,42 @@ def scatter_coeff(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp.i
             val = hc[i, j]
             wp.atomic_add(blocks, base + (3 + i) * bsz + 3 + j, val)
             wp.atomic_add(blocks, base_t + (3 + j) * bsz + 3 + i, val)
+
+
+@wp.kernel
+def section_bounds(
+    edge_vertex: wp.array(dtype=wp.vec2i),
+    vertex_offset: wp.array(dtype=wp.int32),
+    edge_r0: wp.array(dtype=wp.float64),
+    edge_nu: wp.array(dtype=wp.float64),
+    edge_rigid: wp.array(dtype=wp.int32),
+    coeff_count: int,
+    rod_mean: int,
+    x_in: wp.array(dtype=wp.vec3d),
+    coeff_in: wp.array(dtype=wp.float64),
+    rest_in: wp.array(dtype=wp.float64),
+    lam_in: wp.array(dtype=wp.float64),
+    amp_out: wp.array(dtype=wp.float64),
+    rbase_out: wp.array(dtype=wp.float64),
+):
+    """The pass kernels' bounds on the boundaries, once per state: each vertex's modes'
+    amplitude sum [m] (threads 0 .. V - 1) and each edge's largest mean radius
+    r0 lam^-nu [m] (threads V .. V + E - 1; r0 for a rigid section)."""
+    tid = wp.tid()
+    nv = amp_out.shape[0]
+    if tid < nv:
+        amp_out[tid] = amplitude_sum(load_section(coeff_in, vertex_offset[tid], coeff_count),
+                                     coeff_count)
+        return
+    e = tid - nv
+    if edge_rigid[e] != 0:
+        rbase_out[e] = edge_r0[e]
+        return
+    ev = edge_vertex[e]
+    lam = wp.length(x_in[ev[1]] - x_in[ev[0]]) / rest_in[e]
+    if rod_mean != 0:
+        lam = lam_in[e]
+    rbase_out[e] = edge_r0[e] * wp.pow(lam, -edge_nu[e])
 
 
 @wp.kernel
