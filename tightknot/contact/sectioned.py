@@ -744,7 +744,8 @@ class SectionedLayer(ContactLayer):
             host = pairs.numpy().astype(np.int64)
             owner = np.stack([host[:, 0], host[:, 1]], axis=1).reshape(-1)  # pass -> its A
             p = np.where(out["weight"] > 0.0, out["pen"], 0.0)
-            np.maximum.at(pen, owner, np.maximum(p, 0.0))
+            touch = np.flatnonzero((p > 0.0).any(axis=(1, 2)))  # the passes in contact
+            np.maximum.at(pen, owner[touch], p[touch])
         # the deformed boundary's length element r ds at each sample, per Gauss circle
         c0, c1 = self.edge_sections(extra, frames[2])
         phis = 2.0 * math.pi * (np.arange(ms) + 0.5) / ms

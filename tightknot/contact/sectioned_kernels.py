@@ -445,6 +445,56 @@ def radius_partials(c: vecKd, k: int, rigid: int, r0: wp.float64, base: wp.vec3d
 
 
 @wp.func
+def reduce_vec(y: vec6d, dmat: wp.mat33d, dirv: wp.vec3d, deform_a: int) -> vec16d:
+    """J^T y for a 6-vector y over (w, e) = (P - x_B0, x_B1 - x_B0): the reduced
+    directions (x_A0, x_A1, x_B0, x_B1, A's section direction; B's three are zero), where
+    dP/dx_A1 = ``dmat``, dP/dx_A0 = I - dmat and dP/dalpha = ``dirv`` (``deform_a``)."""
+    out = vec16d()
+    for i in range(3):
+        t = f64(0.0)
+        for r in range(3):
+            t += dmat[r, i] * y[r]
+        out[i] = y[i] - t
+        out[3 + i] = t
+        out[6 + i] = -(y[i] + y[3 + i])
+        out[9 + i] = y[3 + i]
+    if deform_a != 0:
+        out[12] = dirv[0] * y[0] + dirv[1] * y[1] + dirv[2] * y[2]
+    return out
+
+
+@wp.func
+def reduce_mat(h6: mat66d, dmat: wp.mat33d, dirv: wp.vec3d, deform_a: int) -> mat16d:
+    """J^T H J for a symmetric 6 x 6 H over (w, e) (J as in :func:`reduce_vec`), by J's
+    blocks (identities, dP/dx_A1 and A's section direction) rather than as dense products."""
+    g = mat6x16d()  # H J, its 13 nonzero columns
+    for r in range(6):
+        for i in range(3):
+            hd = f64(0.0)
+            for m in range(3):
+                hd += h6[r, m] * dmat[m, i]
+            g[r, i] = h6[r, i] - hd
+            g[r, 3 + i] = hd
+            g[r, 6 + i] = -(h6[r, i] + h6[r, 3 + i])
+            g[r, 9 + i] = h6[r, 3 + i]
+        if deform_a != 0:
+            g[r, 12] = h6[r, 0] * dirv[0] + h6[r, 1] * dirv[1] + h6[r, 2] * dirv[2]
+    out = mat16d()
+    for c in range(13):
+        for i in range(3):
+            t = f64(0.0)
+            for m in range(3):
+                t += dmat[m, i] * g[m, c]
+            out[i, c] = g[i, c] - t
+            out[3 + i, c] = t
+            out[6 + i, c] = -(g[i, c] + g[3 + i, c])
+            out[9 + i, c] = g[3 + i, c]
+        if deform_a != 0:
+            out[12, c] = dirv[0] * g[0, c] + dirv[1] * g[1, c] + dirv[2] * g[2, c]
+    return out
+
+
+@wp.func
 def add_pee(target: mat16d, pee: wp.mat33d, row: wp.vec3d, deform_a: int) -> mat16d:
     """target with the second derivatives of P in a's edge vector (``pee``, on x_A0 and
     x_A1 with the signs of e = x_A1 - x_A0) and their coupling ``row`` to a's section
@@ -735,16 +785,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         rb_llx = f64(0.0)
                     dra = (ra_lx / rest_in[ea]) * ta
                     dp_de = u * eye + r_a * m_dir + wp.outer(dirv, dra)
-                    jr = mat6x16d()
-                    for i in range(3):
-                        for j in range(3):
-                            jr[i, j] = eye[i, j] - dp_de[i, j]
-                            jr[i, 3 + j] = dp_de[i, j]
-                            jr[i, 6 + j] = -eye[i, j]
-                            jr[3 + i, 6 + j] = -eye[i, j]
-                            jr[3 + i, 9 + j] = eye[i, j]
-                        if rig_a == 0:
-                            jr[i, 12] = dirv[i]
                     lam_dir = join6(wp.vec3d(), tb / rest_in[eb])
                     lam_hess = add_block(mat66d(), 3, 3, (eye - wp.outer(tb, tb))
                                          / (lb * rest_in[eb]))
@@ -764,39 +804,49 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         dlam_a += a_s * ra_l * (-wt * ph[1] * wp.dot(dwa, dirv)
                                                 + ph[0] * wt1 * wp.dot(dva, dirv))
                         dlam_b += a_s * wt * ph[1] * rb_l
-                    r_g = wp.transpose(jr) @ g_we
-                    r_v = wp.transpose(jr) @ gv
-                    r_psi = wp.transpose(jr) @ gpsi
-                    hg = wp.transpose(jr) @ (h_we @ jr)
-                    hvr = wp.transpose(jr) @ (cyl.hv @ jr)
+                    # The sample's gradient and Hessian over the 16 reduced directions:
+                    # E = a_s wt phi(pen) with pen = r_B - rho, its 6-space part over
+                    # (w, e) carried by the reduced Jacobian J (reduce_vec, reduce_mat),
+                    # then B's section directions (beta: r_B itself, gamma: psi, delta: v)
+                    # and P's own second derivatives.
+                    c_gg = a_s * wt * ph[2]
+                    c_g = a_s * wt * ph[1]
+                    c_gv = a_s * ph[1] * wt1
+                    c_vv = a_s * ph[0] * wt2
+                    c_v = a_s * ph[0] * wt1
+                    h6 = (c_gg * wp.outer(g_we, g_we) - c_gv * (wp.outer(g_we, gv)
+                                                                + wp.outer(gv, g_we))
+                          + c_vv * wp.outer(gv, gv) - c_g * h_we + c_v * cyl.hv)
+                    h = reduce_mat(h6, dp_de, dirv, 1 - rig_a)
+                    jg = reduce_vec(g_we, dp_de, dirv, 1 - rig_a)
+                    jq = reduce_vec(gv, dp_de, dirv, 1 - rig_a)
+                    r_grad = -c_g * jg + c_v * jq
                     if rig_b == 0:
-                        r_g[13] = r_g[13] - f64(1.0)
-                        for c in range(16):
-                            hg[c, 14] = hg[c, 14] - r_psi[c]
-                            hg[14, c] = hg[14, c] - r_psi[c]
-                            hg[c, 15] = hg[c, 15] - r_v[c]
-                            hg[15, c] = hg[15, c] - r_v[c]
-                    # P's own second derivatives in A's edge vector, contracted with dg/dw
-                    # and dv/dw
+                        # pen's -1 in beta, and dpen/dgamma = -r_psi, dpen/ddelta = -r_v
+                        # about the sample (r_psi = J^T grad psi, r_v = J^T grad v)
+                        js = reduce_vec(gpsi, dp_de, dirv, 1 - rig_a)
+                        r_grad[13] = c_g
+                        for c in range(13):
+                            v13 = -c_gg * jg[c] + c_gv * jq[c]
+                            h[c, 13] = h[c, 13] + v13
+                            h[13, c] = h[13, c] + v13
+                            h[c, 14] = h[c, 14] + c_g * js[c]
+                            h[14, c] = h[14, c] + c_g * js[c]
+                            h[c, 15] = h[c, 15] + c_g * jq[c]
+                            h[15, c] = h[15, c] + c_g * jq[c]
+                        h[13, 13] = h[13, 13] + c_gg
+                    # P's own second derivatives in A's edge vector, contracted with the
+                    # energy's gradient over w (linear in it: one contraction for both
+                    # the penetration's and the partition's parts)
                     hra = ((ra_llx / (rest_in[ea] * rest_in[ea])) * wp.outer(ta, ta)
                            + (ra_lx / (la * rest_in[ea])) * (eye - wp.outer(ta, ta)))
-                    for side in range(2):
-                        gw = wp.vec3d(g_we[0], g_we[1], g_we[2])
-                        if side == 1:
-                            gw = wp.vec3d(gv[0], gv[1], gv[2])
-                        row = wp.transpose(m_dir) @ gw
-                        pee = (r_a * (cphi * contract(gw, fa.t1x, fa.t1y, fa.t1z)
-                                      + sphi * contract(gw, fa.t2x, fa.t2y, fa.t2z))
-                               + wp.outer(row, dra) + wp.outer(dra, row) + wp.dot(gw, dirv) * hra)
-                        if side == 0:
-                            hg = add_pee(hg, pee, row, 1 - rig_a)
-                        else:
-                            hvr = add_pee(hvr, pee, row, 1 - rig_a)
-                    r_grad = a_s * (-wt * ph[1] * r_g + ph[0] * wt1 * r_v)
-                    h = (wt * ph[2]) * wp.outer(r_g, r_g) - (wt * ph[1]) * hg
-                    h -= (ph[1] * wt1) * (wp.outer(r_g, r_v) + wp.outer(r_v, r_g))
-                    h += ph[0] * (wt2 * wp.outer(r_v, r_v) + wt1 * hvr)
-                    h = a_s * h
+                    gw = (-c_g * wp.vec3d(g_we[0], g_we[1], g_we[2])
+                          + c_v * wp.vec3d(gv[0], gv[1], gv[2]))
+                    row = wp.transpose(m_dir) @ gw
+                    pee = (r_a * (cphi * contract(gw, fa.t1x, fa.t1y, fa.t1z)
+                                  + sphi * contract(gw, fa.t2x, fa.t2y, fa.t2z))
+                           + wp.outer(row, dra) + wp.outer(dra, row) + wp.dot(gw, dirv) * hra)
+                    h = add_pee(h, pee, row, 1 - rig_a)
                     # The sample's gradient and Hessian carried from the 16 reduced
                     # directions to the pass's dofs (the section directions: alpha by
                     # (1 - u) and u Q to A's vertices, beta and gamma by (1 - v) and v Q,
