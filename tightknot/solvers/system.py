@@ -30,11 +30,6 @@ from tightknot.rods.term import BlockHessian, EnergyTerm
 from tightknot.solvers.linear import LowRankHessian, SparseDirect
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
-#: Largest square of the system size for which a dof term's pattern union is found on a
-#: dense map of int32 marks (up to 64 MiB; about 4000 dofs, e.g. 150 vertices with N = 8
-#: modes has 2504); larger systems sort their entries instead.
-DENSE_SLOT_MAP = 1 << 24
-
 
 @dataclass
 class Inertia:
@@ -451,27 +446,14 @@ class RodSystem:
         e_cols = np.repeat(np.arange(n), np.diff(hmat.indptr))
         all_r = np.concatenate([hmat.indices, rows.ravel()[valid]]).astype(np.int64)
         all_c = np.concatenate([e_cols, cols.ravel()[valid]]).astype(np.int64)
-        lin = all_c * size + all_r  # an entry's place in column-major order
-        if size * size <= DENSE_SLOT_MAP:
-            # marks on a dense map give the union in order without a sort
-            mark = np.zeros(size * size, dtype=np.int32)
-            mark[lin] = 1
-            u_lin = np.flatnonzero(mark)
-            mark[u_lin] = np.arange(u_lin.size, dtype=np.int32)
-            slots = mark[lin].astype(np.int64)
-            indices_u = (u_lin % size).astype(np.int32)
-            indptr_u = np.zeros(size + 1, dtype=np.int32)
-            np.cumsum(np.bincount(u_lin // size, minlength=size), out=indptr_u[1:])
-        else:
-            union = sp.csc_matrix((np.ones(all_r.size), (all_r, all_c)), shape=(size, size))
-            union.sum_duplicates()
-            indptr_u, indices_u = union.indptr, union.indices
-            u_cols = np.repeat(np.arange(size, dtype=np.int64), np.diff(indptr_u))
-            slots = np.searchsorted(u_cols * size + indices_u, lin)
+        union = sp.csc_matrix((np.ones(all_r.size), (all_r, all_c)), shape=(size, size))
+        union.sum_duplicates()
+        u_cols = np.repeat(np.arange(size, dtype=np.int64), np.diff(union.indptr))
+        slots = np.searchsorted(u_cols * size + union.indices, all_c * size + all_r)
         cache = {"keys": keys, "full_rows": full_rows, "full_cols": full_cols,
                  "indptr": hmat.indptr.copy(), "indices": hmat.indices.copy(),
                  "valid": valid, "slot_e": slots[:hmat.nnz], "slot_t": slots[hmat.nnz:],
-                 "indptr_u": indptr_u, "indices_u": indices_u, "size": size}
+                 "indptr_u": union.indptr, "indices_u": union.indices, "size": size}
         self._own_pattern = cache
         return cache
 
