@@ -638,7 +638,7 @@ class SectionedLayer(ContactLayer):
         if (derivatives and last is not None and np.array_equal(last[0], x)
                 and np.array_equal(last[1], extra) and np.array_equal(last[2], rest)
                 and all(np.allclose(a, b, rtol=0.0, atol=FRAME_MATCH)
-                        for a, b in zip(last[3], frames))):
+                        for a, b in zip(last[3], frames, strict=True))):
             # The Newton loop asks for the derivatives where it last evaluated the energy
             # alone, in the frames carried there (equal to round-off): the pairs in
             # contact are those found then.
