@@ -271,6 +271,38 @@ def test_sections_thinned_by_the_rods_mean_stretch_have_an_exact_gradient() -> N
     check_derivatives(system, D0, rng, hess_tol=1e-4)
 
 
+def test_derivatives_after_the_energy_alone_reuse_its_pairs() -> None:
+    # The Newton loop asks for the derivatives at the trial whose energy it just evaluated
+    # alone: contact_energy then takes that evaluation's pairs in contact instead of
+    # launching the energy kernel again. The result is that of a fresh evaluation (the
+    # same passes; the energy summed over fewer zeros: round-off), and frames that differ
+    # (here a reference twist turned by 0.1 rad) launch it again.
+    system, layer, rng = _crossing_rods(0.97, 1.0, SectionSettings(max_mode=6, samples=32))
+    x, rest, frames = system.state.x, system.rest, system.state.frames
+    extra = 0.002 * D0 * rng.normal(size=layer.dof_count)
+    fresh = layer.contact_energy(x, extra, frames, rest, True, True)
+    kernels = []
+    launch = layer._launch
+
+    def counted(kernel, *args, **kw):
+        kernels.append(kernel)
+        return launch(kernel, *args, **kw)
+
+    layer._launch = counted
+    layer.contact_energy(x, extra, frames, rest, False, False)
+    reused = layer.contact_energy(x, extra, frames, rest, True, True)
+    assert kernels == [sk.ENERGY, sk.DERIVATIVES]
+    assert fresh[0] > 0.0 and reused[0] == pytest.approx(fresh[0], rel=1e-12)
+    for a, b in ((fresh[1], reused[1]), (fresh[2], reused[2]),
+                 (fresh[3].blocks, reused[3].blocks)):
+        assert np.array_equal(a, b)
+    turned = (frames[0], frames[1], frames[2] + 0.1)
+    kernels.clear()
+    layer.contact_energy(x, extra, frames, rest, False, False)
+    layer.contact_energy(x, extra, turned, rest, True, True)
+    assert kernels == [sk.ENERGY, sk.ENERGY, sk.DERIVATIVES]
+
+
 def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator,
                       hess_tol: float = 0.03) -> None:
     """A rod system with a sectioned level, its sections deformed at random (0.002 D0): the
