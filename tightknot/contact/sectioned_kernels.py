@@ -21,10 +21,13 @@ pair of its nodes (the coordinates' 12 x 12, the coordinates against each vertex
 coefficients, the coefficients' K x K blocks), which are added into the node-pair blocks
 once per pass.
 
-Work is skipped where no contact can be: a Gauss circle of A whose axis point is farther
-from B's axis than the two sections' largest radii, and a sample farther from B's axis
-than B's largest radius (the bounds: the mean radius at the edge's stretch and the
-coefficients' absolute sums, which bound every boundary radius).
+Work is skipped where no contact can be: a pass whose edges lie farther apart than the
+two sections' largest radii, a Gauss circle of A whose axis point is farther from B's axis
+than those radii, and a sample farther from B's axis than B's largest radius (the bounds:
+the mean radius at the edge's stretch and the coefficients' amplitude sums, which bound
+every boundary radius; computed once per state by :func:`section_bounds`). A sample is
+first tested at its mean radius, with A's amplitude sum as margin, so that the samples
+skipped never have their modes summed.
 
 Loops are not unrolled and no backward code is generated (derivatives are written by hand;
 local vectors are assigned in place), as in the compliant level's module.
