@@ -130,14 +130,14 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
             arr([a.arc, b.arc], wp.vec2d), arr([1.0, 1.0], f), lam, *bounds,
             arr([[0, 1]], wp.vec2i), arr(np.arange(16), wp.int32)]
     bsz = 3 + K
-    outs = [wp.zeros(2, dtype=f), wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),
+    outs = [wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),
             wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f),
             wp.zeros(1, dtype=f)]
     wp.launch(sk.DERIVATIVES, 2, model + data, outs)
-    g = outs[2].numpy().reshape(2, nl)
+    g = outs[1].numpy().reshape(2, nl)
     grad = g[0].copy()
     grad[swap_order(K)] += g[1]
-    blocks = outs[3].numpy().reshape(4, 4, bsz, bsz)
+    blocks = outs[2].numpy().reshape(4, 4, bsz, bsz)
     # node n's local dofs: positions 3n..3n+2, sections 12 + K n ..
     local = [np.r_[3 * n:3 * n + 3, 12 + K * n:12 + K * (n + 1)] for n in range(4)]
     hess = np.zeros((nl, nl))

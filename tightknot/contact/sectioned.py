@@ -330,9 +330,8 @@ class SectionedLayer(ContactLayer):
         self._in_twist = Staging(f64, dev)
         self._in_rest = Staging(f64, dev)
         self._in_margin = Staging(f64, dev)
-        #: The last evaluation: candidate pairs, each pair's deepest penetration [m].
-        # the state (x, extra, rest) of the last energy-only evaluation and its pairs in
-        # contact (:meth:`contact_energy`)
+        # the state (x, extra, rest, frames) of the last energy-only evaluation and its
+        # pairs in contact (:meth:`contact_energy`)
         self._energy_only: tuple | None = None
 
     # -- the section field -----------------------------------------------------------------
@@ -484,7 +483,6 @@ class SectionedLayer(ContactLayer):
         nl = 12 + 4 * self.section.coeff_count
         ng = len(self.settings.gauss[0])
         energy = wp.zeros(threads, dtype=f64, device=dev)
-        pen_max = wp.zeros(threads, dtype=f64, device=dev)
         grad = wp.zeros(threads * nl if derivatives else 1, dtype=f64, device=dev)
         b = 3 + self.section.coeff_count
         blocks = wp.zeros(block_count * b * b if derivatives else 1, dtype=f64, device=dev)
@@ -502,8 +500,8 @@ class SectionedLayer(ContactLayer):
         wp.launch(kernel, threads, [*self._model_args, wx, *data, self._vertex_amp,
                                     self._edge_rbase, self.broad_phase.buffer_of(pairs),
                                     w_slots],
-                  [energy, pen_max, grad, blocks, s_pen, s_wt, dlam], device=dev)
-        out = {"energy": energy.numpy(), "pen_max": pen_max.numpy()}
+                  [energy, grad, blocks, s_pen, s_wt, dlam], device=dev)
+        out = {"energy": energy.numpy()}
         if derivatives:
             out["grad"] = grad.numpy().reshape(threads, nl)
             out["blocks"] = blocks.numpy().reshape(block_count, b, b)

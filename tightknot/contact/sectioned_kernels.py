@@ -557,7 +557,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         slots_in: wp.array(dtype=wp.int32),
         # Out:
         energy_out: wp.array(dtype=wp.float64),
-        pen_max_out: wp.array(dtype=wp.float64),
         grad_out: wp.array(dtype=wp.float64),
         blocks_out: wp.array(dtype=wp.float64),
         sample_pen_out: wp.array(dtype=wp.float64),
@@ -580,7 +579,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 sample_pen_out[so + q] = f64(0.0)
                 sample_weight_out[so + q] = f64(0.0)
         energy = f64(0.0)
-        pen_max = f64(-1.0e30)
         va = edge_vertex[ea]
         vb = edge_vertex[eb]
         xa0 = x_in[va[0]]
@@ -614,7 +612,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             r_b_max = edge_r0[eb]
         if segment_line_distance(xa0, x_in[va[1]], xb0, vec_b) > r_a_max + r_b_max:
             energy_out[tid] = energy
-            pen_max_out[tid] = pen_max
             return
         # The sections of the edges' vertices, the second one's turned into the edge's
         # frame.
@@ -693,7 +690,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             ra_mean, ra_l, ra_ll = radius_partials(ca, k, rig_a, edge_r0[ea], base_a)
             if ra_mean <= f64(0.0):
                 energy_out[tid] = f64(1.0e300)
-                pen_max_out[tid] = pen_max
                 return
             s_a = arc_a[0] + u * (arc_a[1] - arc_a[0])
             for kk in range(samples):
@@ -732,7 +728,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 rb_mean, rb_l, rb_ll = radius_partials(cb, k, rig_b, edge_r0[eb], base_b)
                 if rb_mean <= f64(0.0):
                     energy_out[tid] = f64(1.0e300)
-                    pen_max_out[tid] = pen_max
                     return
                 r_b = rb_mean
                 r_b1 = f64(0.0)
@@ -747,8 +742,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 om = partition_weight(v, endb[0], endb[1])
                 wex = exclusion_weight(same_rod, closed, rod_len, s_a, arc_b, excl, v)
                 wt = om[0] * wex[0]
-                if wt > f64(0.0):
-                    pen_max = wp.max(pen_max, pen)
                 if wp.static(report):
                     sample_pen_out[so + gi * samples + kk] = pen
                     sample_weight_out[so + gi * samples + kk] = wt
@@ -962,7 +955,6 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 dlam_out[2 * tid] = dlam_a
                 dlam_out[2 * tid + 1] = dlam_b
         energy_out[tid] = energy
-        pen_max_out[tid] = pen_max
 
     key = f"sectioned_pass_d{int(derivatives)}_r{int(report)}"
     return wp.Kernel(sectioned_pass, key=key, module=wp.get_module(__name__))
