@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import warp as wp
 
+from tightknot.contact import sectioned
 from tightknot.contact import sectioned_kernels as sk
 from tightknot.contact.section_modes import mode_stiffness
 from tightknot.contact.sectioned import SectionedLayer, SectionSettings
@@ -301,6 +302,49 @@ def test_derivatives_after_the_energy_alone_reuse_its_pairs() -> None:
     layer.contact_energy(x, extra, frames, rest, False, False)
     layer.contact_energy(x, extra, turned, rest, True, True)
     assert kernels == [sk.ENERGY, sk.ENERGY, sk.DERIVATIVES]
+
+
+def test_pass_kernels_split_over_threads_give_the_unsplit_result(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # On a CPU a pass kernel's launch is split into chunks of pairs on threads. Each
+    # pass's outputs (energy, gradient, the mean-stretch derivative, the report's samples)
+    # are the unsplit launch's bit for bit: a pass is computed by one thread alone, in
+    # any chunk. The Hessian blocks are summed chunk by chunk (round-off: 1e-13 relative
+    # allowed, a few ulps of the sums of up to a few dozen terms).
+    assert sectioned.pair_chunks(31) == [(0, 31)]
+    assert sectioned.pair_chunks(33) == [(0, 17), (17, 33)]
+    assert np.array_equal(sectioned.interleaved(5, 2), [0, 2, 4, 1, 3])
+    system, layer, rng = _crossing_rods(
+        0.97, 1.05, SectionSettings(max_mode=6, samples=32, thinning="rod"))
+    x, rest, frames = system.state.x, system.rest, system.state.frames
+    extra = 0.002 * D0 * rng.normal(size=layer.dof_count)
+    monkeypatch.setattr(sectioned, "MIN_CHUNK_PAIRS", 1)
+    runs = []
+    for chunks in (1, 3):
+        monkeypatch.setattr(sectioned, "CPU_CHUNKS", chunks)
+        monkeypatch.setattr(sectioned, "_POOL", None)
+        sizes = []
+        launch = layer._launch
+
+        def counted(kernel, wx, pairs, *args, sizes=sizes, launch=launch, **kw):
+            sizes.append(len(sectioned.pair_chunks(pairs.shape[0])))
+            return launch(kernel, wx, pairs, *args, **kw)
+
+        layer._launch = counted
+        for _ in range(2):  # the second time on the pool's threads (the first loads)
+            energy, g_x, g_c, hess = layer.contact_energy(x, extra, frames, rest, True, True)
+            report = layer.section_report(x, extra, frames, rest)
+        del layer._launch
+        assert set(sizes) == {chunks}
+        runs.append((energy, g_x, g_c, hess, report))
+    (e1, gx1, gc1, h1, r1), (e3, gx3, gc3, h3, r3) = runs
+    assert e1 > 0.0 and r1["contact_width_fraction"].max() > 0.0
+    assert e3 == pytest.approx(e1, rel=1e-14)
+    assert np.array_equal(gx1, gx3) and np.array_equal(gc1, gc3)
+    assert np.array_equal(h1.keys, h3.keys)
+    assert np.abs(h3.blocks - h1.blocks).max() <= 1e-13 * np.abs(h1.blocks).max()
+    for key, value in r1.items():
+        assert np.array_equal(value, r3[key]), key
 
 
 def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator,

@@ -74,22 +74,25 @@ def test_the_final_path_reaches_the_full_paths_equilibrium() -> None:
     runs = {}
     for path in ("final", "full"):
         scene = closed_trefoil(16.37, nodes=60, contact="sectioned")
-        res = tie(scene, tighten_steps=20, section_path=path).run()
+        # solved well past the default 1e-6: the closed knot's slide along its rod is a
+        # near-zero mode, along which a loose solve stops wherever round-off leaves it
+        # (at 1e-6 the full path's stretch moved by 6e-5 with the order of a sum)
+        res = tie(scene, tighten_steps=20, section_path=path, residual_tol=1e-8).run()
         assert res.converged, res.failure
         assert res.knot_types[-1] == "3_1"
         runs[path] = (scene, res)
     final, full = (_measures(*runs[p]) for p in ("final", "full"))
-    # the same equilibrium up to the solves' tolerance (measured: stretch 2.1e-6 apart,
-    # L_c 8e-5, A/A0 6e-6; a knot slid along its rod by a part of an edge, a near-zero
-    # mode of the closed knot, moves the sampled maxima by that much)
-    assert final["stretch"] == pytest.approx(full["stretch"], rel=2e-5)
+    # the same knot, up to where along that near-zero mode each path stops (measured:
+    # stretch 6.4e-5 apart, L_c 7.8e-4, A/A0 1.6e-5; the same at 1e-7 and 1e-8, so the
+    # paths end at two nearby equilibria, not at one within the solves' tolerance)
+    assert final["stretch"] == pytest.approx(full["stretch"], rel=1e-4)
     assert final["lc"] == pytest.approx(full["lc"], abs=2e-3)
     assert final["area"] == pytest.approx(full["area"], abs=1e-4)
     res_final = runs["final"][1]
     assert list(res_final.phases) == ["tighten", "section"]
     assert "section" not in runs["full"][1].phases
     # the sectioned level's Newton iterations: one solve against every load step's
-    # (measured 155 in all, 289)
+    # (measured 140 in all, 267)
     assert res_final.phases["section"].newton_iterations < \
         runs["full"][1].phases["tighten"].newton_iterations / 2
     assert res_final.system.state.extra.size == runs["final"][0].contact.dof_count

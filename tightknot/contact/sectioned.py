@@ -38,6 +38,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -60,6 +61,40 @@ MIN_MODES = 4
 #: which the second reuses the first's pairs in contact (frames carried to the same
 #: positions differ by round-off only).
 FRAME_MATCH = 1e-9
+#: Chunks of pairs a pass kernel's launch on a CPU is split into, each on its own thread
+#: (Warp's CPU kernels run on one thread and release the GIL while they run). A fixed
+#: count, not the machine's cores, so that the results are the same on every machine.
+CPU_CHUNKS = 2
+#: Fewest pairs per chunk: below, a thread's hand-over (tens of microseconds) costs more
+#: than the half kernel it saves.
+MIN_CHUNK_PAIRS = 16
+
+_POOL: ThreadPoolExecutor | None = None
+
+
+def pair_chunks(count: int) -> list[tuple[int, int]]:
+    """Half-open ranges of ``count`` pairs in :func:`interleaved` order: at most
+    :data:`CPU_CHUNKS` chunks of at least :data:`MIN_CHUNK_PAIRS` pairs (one chunk when
+    there are fewer), chunk c holding the pairs c, c + C, c + 2 C ..."""
+    n = max(1, min(CPU_CHUNKS, count // MIN_CHUNK_PAIRS))
+    sizes = [len(range(c, count, n)) for c in range(n)]
+    edges = np.concatenate([[0], np.cumsum(sizes)]).astype(int).tolist()
+    return list(zip(edges[:-1], edges[1:], strict=True))
+
+
+def interleaved(count: int, chunks: int) -> np.ndarray:
+    """The order of ``count`` pairs in which chunk c of :func:`pair_chunks` holds the
+    pairs c, c + ``chunks``, c + 2 ``chunks`` ..."""
+    return np.concatenate([np.arange(c, count, chunks) for c in range(chunks)])
+
+
+def _chunk_pool() -> ThreadPoolExecutor:
+    """The threads that launch the chunks after the first (one pool per process)."""
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=CPU_CHUNKS - 1,
+                                   thread_name_prefix="tightknot-pass")
+    return _POOL
 
 _CALIBRATION_FILE = Path(__file__).resolve().parents[1] / "data" / "section_calibration.json"
 
@@ -319,6 +354,8 @@ class SectionedLayer(ContactLayer):
                              edge_rigid, k, rod_mean]
         self._vertex_amp = wp.zeros(m.vertex_count, dtype=f64, device=dev)
         self._edge_rbase = wp.zeros(m.edge_count, dtype=f64, device=dev)
+        #: Pass kernels launched once (their modules loaded; :meth:`_launch`).
+        self._launched: set[str] = set()
         #: Each rod's mean stretch (the sections' thinning with ``thinning="rod"``).
         self.rod_mean = (RodMeanRadius(m, self.edge_nu) if self.section.thinning == "rod"
                          else None)
@@ -476,40 +513,90 @@ class SectionedLayer(ContactLayer):
         """Launch ``kernel`` over both passes of ``pairs`` with the state arrays ``data``
         (coefficients, frames, end twists, rest lengths, arcs, rod lengths); with
         ``derivatives``, the Hessian goes into ``block_count`` node-pair blocks, pair p's
-        16 at ``slots[p]`` (nodes a0, a1, b0, b1)."""
+        16 at ``slots[p]`` (nodes a0, a1, b0, b1). On a CPU the pairs are split into
+        :func:`pair_chunks`, launched on as many threads."""
         dev = self.device
         f64 = wp.float64
         threads = 2 * pairs.shape[0]
         nl = 12 + 4 * self.section.coeff_count
         ng = len(self.settings.gauss[0])
+        ns = ng * self.section.samples if report else 0
+        with_lam = derivatives and self.rod_mean is not None
         energy = wp.zeros(threads, dtype=f64, device=dev)
         grad = wp.zeros(threads * nl if derivatives else 1, dtype=f64, device=dev)
+        s_pen = wp.zeros(max(threads * ns, 1), dtype=f64, device=dev)
+        s_wt = wp.zeros(max(threads * ns, 1), dtype=f64, device=dev)
+        dlam = wp.zeros(2 * threads if with_lam else 1, dtype=f64, device=dev)
         b = 3 + self.section.coeff_count
-        blocks = wp.zeros(block_count * b * b if derivatives else 1, dtype=f64, device=dev)
         w_slots = wp.array(slots.astype(np.int32).ravel() if derivatives else np.zeros(1, np.int32),
                            dtype=wp.int32, device=dev)
-        ns = threads * ng * self.section.samples if report else 1
-        s_pen = wp.zeros(ns, dtype=f64, device=dev)
-        s_wt = wp.zeros(ns, dtype=f64, device=dev)
-        with_lam = derivatives and self.rod_mean is not None
-        dlam = wp.zeros(2 * threads if with_lam else 1, dtype=f64, device=dev)
         coeff, rest, lam = data[0], data[4], data[-1]
         nv, ne = self.model.vertex_count, self.model.edge_count
         wp.launch(sk.section_bounds, nv + ne, [*self._bounds_args, wx, coeff, rest, lam],
                   [self._vertex_amp, self._edge_rbase], device=dev)
-        wp.launch(kernel, threads, [*self._model_args, wx, *data, self._vertex_amp,
-                                    self._edge_rbase, self.broad_phase.buffer_of(pairs),
-                                    w_slots],
-                  [energy, grad, blocks, s_pen, s_wt, dlam], device=dev)
-        out = {"energy": energy.numpy()}
+        npairs = pairs.shape[0]
+        chunks = (pair_chunks(npairs) if wp.get_device(dev).is_cpu else [(0, npairs)])
+        order = None
+        if len(chunks) > 1:
+            # Chunk c takes every C-th pair from c: the pairs in contact come in runs (a
+            # crossing's edges are neighbours), which contiguous chunks would give to one
+            # thread.
+            order = interleaved(npairs, len(chunks))
+            buf = wp.array(pairs.numpy()[order], dtype=wp.vec2i, device=dev)
+            if derivatives:
+                w_slots = wp.array(slots.astype(np.int32)[order].ravel(), dtype=wp.int32,
+                                   device=dev)
+        else:
+            buf = self.broad_phase.buffer_of(pairs)
+        # Each chunk adds its Hessian into blocks of its own (summed below in chunk
+        # order, so that the result does not depend on which thread ends first).
+        blocks = [wp.zeros(block_count * b * b if derivatives else 1, dtype=f64, device=dev)
+                  for _ in chunks]
+
+        def run(i: int) -> None:
+            lo, hi = chunks[i]
+            part = (lambda a, per: a[per * lo:per * hi]) if len(chunks) > 1 else (
+                lambda a, per: a)
+            wp.launch(kernel, 2 * (hi - lo),
+                      [*self._model_args, wx, *data, self._vertex_amp, self._edge_rbase,
+                       part(buf, 1), part(w_slots, 16) if derivatives else w_slots],
+                      [part(energy, 2), part(grad, 2 * nl) if derivatives else grad, blocks[i],
+                       part(s_pen, 2 * ns) if report else s_pen,
+                       part(s_wt, 2 * ns) if report else s_wt,
+                       part(dlam, 4) if with_lam else dlam], device=dev)
+
+        if len(chunks) > 1 and kernel.key in self._launched:
+            pending = [_chunk_pool().submit(run, i) for i in range(1, len(chunks))]
+            run(0)
+            for job in pending:
+                job.result()
+        else:
+            # the first launch of a kernel loads its module: not from two threads at once
+            for i in range(len(chunks)):
+                run(i)
+            self._launched.add(kernel.key)
+
+        def unpermuted(a: wp.array, width: int) -> np.ndarray:
+            """Pass outputs (``width`` numbers per pass) back in the pairs' order."""
+            flat = a.numpy().reshape(npairs, 2 * width)
+            if order is None:
+                return flat.reshape(-1, width)
+            back = np.empty_like(flat)
+            back[order] = flat
+            return back.reshape(-1, width)
+
+        out = {"energy": unpermuted(energy, 1).ravel()}
         if derivatives:
-            out["grad"] = grad.numpy().reshape(threads, nl)
-            out["blocks"] = blocks.numpy().reshape(block_count, b, b)
+            out["grad"] = unpermuted(grad, nl)
+            total = blocks[0].numpy()
+            for more in blocks[1:]:
+                total = total + more.numpy()
+            out["blocks"] = total.reshape(block_count, b, b)
         if with_lam:
-            out["dlam"] = dlam.numpy().reshape(threads, 2)
+            out["dlam"] = unpermuted(dlam, 2)
         if report:
-            out["pen"] = s_pen.numpy().reshape(threads, ng, self.section.samples)
-            out["weight"] = s_wt.numpy().reshape(threads, ng, self.section.samples)
+            out["pen"] = unpermuted(s_pen, ns).reshape(threads, ng, self.section.samples)
+            out["weight"] = unpermuted(s_wt, ns).reshape(threads, ng, self.section.samples)
         return out
 
     def _state_arrays(self, extra: np.ndarray, t_ref: np.ndarray, d1_ref: np.ndarray,
