@@ -347,6 +347,37 @@ def test_pass_kernels_split_over_threads_give_the_unsplit_result(
         assert np.array_equal(value, r3[key]), key
 
 
+def test_a_grown_pattern_is_the_one_built_afresh() -> None:
+    # Node pairs that come into contact within a load step are merged into the kept union
+    # of the rods' pattern and the section blocks (RodSystem._own_grow): the matrix is the
+    # one a union built afresh over the same pairs gives, pattern and values bit for bit.
+    system, _, _ = _crossing_rods(0.995, 1.0, SectionSettings(max_mode=6, samples=32))
+    calls = []
+    place = system._with_own_hessian
+
+    def recorded(hmat, own):
+        calls.append((hmat, own, system._own_pattern))
+        return place(hmat, own)
+
+    system._with_own_hessian = recorded
+    grow = system._own_grow
+    grows = []
+    system._own_grow = lambda *a: grows.append(a[2].size) or grow(*a)
+    system.evaluate(system.free_vector())
+    kept = system._own_pattern["keys"].size
+    system.state.x[25:, 1] -= 0.03 * D0  # the second rod pressed 0.035 D0 in
+    grown = system.evaluate(system.free_vector())[2]
+    cache = system._own_pattern
+    assert grows and cache["keys"].size == kept + grows[-1] > kept  # grown, not rebuilt
+    hmat, own, _ = calls[-1]
+    order = np.argsort(cache["keys"])
+    system._own_union(hmat, own.node_dofs, cache["keys"][order], cache["full_rows"][order],
+                      cache["full_cols"][order])
+    afresh = place(hmat, own)
+    for name in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(grown, name), getattr(afresh, name)), name
+
+
 def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator,
                       hess_tol: float = 0.03) -> None:
     """A rod system with a sectioned level, its sections deformed at random (0.002 D0): the

@@ -387,21 +387,27 @@ class RodSystem:
         The union of the two patterns and each entry's slot in it are kept through a load
         step: while ``hmat``'s pattern is the same and the blocks' node pairs are among the
         kept ones (contacts that come and go within a step), an evaluation only places
-        values; a node pair that is new grows the kept set. A new load step starts afresh
-        (:meth:`compact_pattern`), so that pairs no longer in contact leave it."""
+        values; node pairs that are new are merged into the kept union (:meth:`_own_grow`).
+        A new load step starts afresh (:meth:`compact_pattern`), so that pairs no longer in
+        contact leave it."""
         cache = self._own_pattern
-        same = (cache is not None and np.array_equal(cache["indptr"], hmat.indptr)
-                and np.array_equal(cache["indices"], hmat.indices))
+        same_base = (cache is not None and np.array_equal(cache["indptr"], hmat.indptr)
+                     and np.array_equal(cache["indices"], hmat.indices))
         nodes = own.node_dofs.shape[0]
         new_keys = own.keys[:, 0] * nodes + own.keys[:, 1]
         rows_in, cols_in = own.masks()
-        if same:
-            kept = cache["keys"]
-            at = np.minimum(np.searchsorted(kept, new_keys), kept.size - 1)
-            same = bool(np.all(kept[at] == new_keys)
-                        and not np.any(rows_in & ~cache["full_rows"][at])
-                        and not np.any(cols_in & ~cache["full_cols"][at]))
-        if not same:
+        if same_base:
+            at, found = _kept_at(cache, new_keys)
+            grown = (found & ((rows_in & ~cache["full_rows"][at])
+                              | (cols_in & ~cache["full_cols"][at])))
+            if grown.any():
+                # a kept block gains rows or columns: the union is built again
+                same_base = False
+            elif not found.all():
+                cache = self._own_grow(cache, own.node_dofs, new_keys[~found],
+                                       rows_in[~found], cols_in[~found])
+                at, _ = _kept_at(cache, new_keys)
+        if not same_base:
             if cache is None:
                 keys, full_r, full_c = new_keys, rows_in, cols_in
             else:
@@ -414,22 +420,23 @@ class RodSystem:
                 full_r[new_at] |= rows_in
                 full_c[new_at] |= cols_in
             cache = self._own_union(hmat, own.node_dofs, keys, full_r, full_c)
-            at = np.searchsorted(keys, new_keys)
+            at, _ = _kept_at(cache, new_keys)
         b = own.blocks.shape[1]
         blocks = np.zeros((cache["keys"].size, b, b))
         blocks[at] = own.blocks
         data = np.zeros(cache["indices_u"].size)
         data[cache["slot_e"]] = hmat.data
+        # each (row, column) entry belongs to one node pair: the slots are distinct
         data[cache["slot_t"]] += blocks.ravel()[cache["valid"]]
         size = cache["size"]
         return sp.csc_matrix((data, cache["indices_u"], cache["indptr_u"]), shape=(size, size))
 
-    def _own_union(self, hmat: sp.csc_matrix, node_dofs: np.ndarray, keys: np.ndarray,
-                   full_rows: np.ndarray, full_cols: np.ndarray) -> dict:
-        """The union of ``hmat``'s pattern with the node blocks of node-pair ``keys`` (row
-        node x nodes + column node; past a node's position, only the rows ``full_rows``
-        and the columns ``full_cols`` of each block), and each entry's slot in it (kept as
-        the cache)."""
+    def _block_entries(self, node_dofs: np.ndarray, keys: np.ndarray, full_rows: np.ndarray,
+                       full_cols: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The free rows and columns (each (K, b, b)) of the node blocks of node-pair
+        ``keys`` (row node x nodes + column node) and which entries are in the system
+        (flat, K b b): both dofs free, and past a node's position only the rows
+        ``full_rows`` and the columns ``full_cols`` of each block."""
         n, n_own = self.pattern.n, self.dof_term.dof_count
         nodes = node_dofs.shape[0]
         index = np.concatenate([self.pattern.free_index, n + np.arange(n_own)])
@@ -442,6 +449,14 @@ class RodSystem:
         valid = ((rows >= 0) & (cols >= 0)
                  & ((local[None, :, None] < 3) | full_rows[:, None, None])
                  & ((local[None, None, :] < 3) | full_cols[:, None, None])).ravel()
+        return rows, cols, valid
+
+    def _own_union(self, hmat: sp.csc_matrix, node_dofs: np.ndarray, keys: np.ndarray,
+                   full_rows: np.ndarray, full_cols: np.ndarray) -> dict:
+        """The union of ``hmat``'s pattern with the node blocks of node-pair ``keys``
+        (:meth:`_block_entries`), and each entry's slot in it (kept as the cache)."""
+        n, n_own = self.pattern.n, self.dof_term.dof_count
+        rows, cols, valid = self._block_entries(node_dofs, keys, full_rows, full_cols)
         size = n + n_own
         e_cols = np.repeat(np.arange(n), np.diff(hmat.indptr))
         all_r = np.concatenate([hmat.indices, rows.ravel()[valid]]).astype(np.int64)
@@ -449,11 +464,52 @@ class RodSystem:
         union = sp.csc_matrix((np.ones(all_r.size), (all_r, all_c)), shape=(size, size))
         union.sum_duplicates()
         u_cols = np.repeat(np.arange(size, dtype=np.int64), np.diff(union.indptr))
-        slots = np.searchsorted(u_cols * size + union.indices, all_c * size + all_r)
-        cache = {"keys": keys, "full_rows": full_rows, "full_cols": full_cols,
+        lin_u = u_cols * size + union.indices
+        slots = np.searchsorted(lin_u, all_c * size + all_r)
+        cache = {"keys": keys, "sort": np.arange(keys.size), "sorted_keys": keys,
+                 "full_rows": full_rows, "full_cols": full_cols,
                  "indptr": hmat.indptr.copy(), "indices": hmat.indices.copy(),
                  "valid": valid, "slot_e": slots[:hmat.nnz], "slot_t": slots[hmat.nnz:],
-                 "indptr_u": union.indptr, "indices_u": union.indices, "size": size}
+                 "lin_u": lin_u, "indptr_u": union.indptr, "indices_u": union.indices,
+                 "size": size}
+        self._own_pattern = cache
+        return cache
+
+    def _own_grow(self, cache: dict, node_dofs: np.ndarray, add_keys: np.ndarray,
+                  full_rows: np.ndarray, full_cols: np.ndarray) -> dict:
+        """``cache`` (:meth:`_own_union`) with the node blocks of the new node pairs
+        ``add_keys`` merged in: the same union and slots as built afresh, found from the
+        new blocks' entries alone. The kept pairs are in the order they came, the new ones
+        after them, so that the kept slots stay a prefix."""
+        size = cache["size"]
+        rows, cols, valid = self._block_entries(node_dofs, add_keys, full_rows, full_cols)
+        lin = cols.ravel()[valid].astype(np.int64) * size + rows.ravel()[valid]
+        lin_u = cache["lin_u"]
+        fresh = np.unique(lin)
+        pos = np.searchsorted(lin_u, fresh)
+        present = lin_u[np.minimum(pos, lin_u.size - 1)] == fresh
+        added = fresh[~present]
+        ins = pos[~present] + np.arange(added.size)  # their places in the grown union
+        is_added = np.zeros(lin_u.size + added.size, dtype=bool)
+        is_added[ins] = True
+        grown = np.empty(is_added.size, dtype=np.int64)
+        grown[ins] = added
+        grown[~is_added] = lin_u
+        old_to_new = np.flatnonzero(~is_added)
+        keys = np.concatenate([cache["keys"], add_keys])
+        order = np.argsort(keys, kind="stable")
+        dtype = cache["indices_u"].dtype
+        counts = np.bincount(grown // size, minlength=size)
+        cache = dict(cache, keys=keys, sort=order, sorted_keys=keys[order],
+                     full_rows=np.concatenate([cache["full_rows"], full_rows]),
+                     full_cols=np.concatenate([cache["full_cols"], full_cols]),
+                     valid=np.concatenate([cache["valid"], valid]),
+                     slot_e=old_to_new[cache["slot_e"]],
+                     slot_t=np.concatenate([old_to_new[cache["slot_t"]],
+                                            np.searchsorted(grown, lin)]),
+                     lin_u=grown,
+                     indptr_u=np.concatenate([[0], np.cumsum(counts)]).astype(dtype),
+                     indices_u=(grown % size).astype(dtype))
         self._own_pattern = cache
         return cache
 
@@ -541,3 +597,13 @@ class RodSystem:
             return self.free_is_theta
         return np.concatenate([self.free_is_theta,
                                np.zeros(size - self.free_is_theta.size, dtype=bool)])
+
+
+def _kept_at(cache: dict, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where node-pair ``keys`` are among a kept union's pairs (:meth:`RodSystem._own_union`)
+    and whether they are there at all."""
+    kept = cache["sorted_keys"]
+    if kept.size == 0:
+        return np.zeros(keys.size, dtype=np.int64), np.zeros(keys.size, dtype=bool)
+    pos = np.minimum(np.searchsorted(kept, keys), kept.size - 1)
+    return cache["sort"][pos], kept[pos] == keys
