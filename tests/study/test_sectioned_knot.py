@@ -118,9 +118,54 @@ def test_an_open_knot_is_sought_again_at_the_sectioned_level() -> None:
     assert all(size == 0 for _, size in calls[:phases.index("section")])
 
 
+def test_the_pull_path_tightens_at_the_compliant_level_and_seeks_with_sections() -> None:
+    """tie_to_lambda with section_path "pull": the relaxation and the tightening at the
+    compliant level, then the sections' equilibrium at the tightened knot, and the force
+    sought with them (125 mm rod at 100 vertices to Lambda_OC 12: 12.05). A pull to a
+    force (tie) on this path: the slow test below."""
+    scene = open_trefoil(0.125, nodes=100, contact="sectioned")
+    calls: list[tuple[str, int]] = []
+    res = tie_to_lambda(scene, 12.0, section_path="pull", hook=lambda phase, system, rec:
+                        calls.append((phase, system.state.extra.size))).run()
+    assert res.converged, res.failure
+    assert set(res.knot_types) == {"3_1"}
+    assert knot_length(scene, res.system) == pytest.approx(12.0, abs=0.1)
+    phases = [c[0] for c in calls]
+    first = phases.index("section")
+    assert set(phases[:first]) == {"tighten"} and phases.count("section") == 1
+    assert "pull" in phases[first:]
+    assert all(size == 0 for _, size in calls[:first])
+    assert all(size == scene.contact.dof_count for _, size in calls[first:])
+
+
+@pytest.mark.slow
+def test_the_pull_path_reaches_the_full_paths_knot() -> None:
+    """The 125 mm knot (150 vertices) pulled by 9.4144 N, tightened at the compliant level
+    ("pull") or with its sections ("full"): the same knot (measured Lambda_OC 10.0637
+    against 10.0716, max L_c 0.8422 against 0.8425, min A/A0 0.6751 against 0.6780; the
+    full path's own search to Lambda_OC 10.1 ended at 10.0595 for this force, so the
+    tolerances, 0.03 in Lambda_OC, 0.01 in L_c and A/A0, are the full path's spread)."""
+    out = {}
+    for path in ("pull", "full"):
+        scene = open_trefoil(0.125, nodes=150, contact="sectioned")
+        res = tie(scene, pull_force=9.4144, section_path=path).run()
+        assert res.converged, res.failure
+        assert set(res.knot_types) == {"3_1"}
+        assert list(res.phases) == (["tighten", "section", "pull"] if path == "pull"
+                                    else ["tighten", "pull"])
+        assert res.system.state.extra.size == scene.contact.dof_count
+        st = res.system.state
+        rep = scene.contact.section_report(st.x, st.extra, st.frames, res.system.rest)
+        out[path] = (knot_length(scene, res.system), rep["contact_width_fraction"].max(),
+                     rep["area_ratio"].min())
+    assert out["pull"][0] == pytest.approx(out["full"][0], abs=0.03)
+    assert out["pull"][1] == pytest.approx(out["full"][1], abs=0.01)
+    assert out["pull"][2] == pytest.approx(out["full"][2], abs=0.01)
+
+
 def test_a_bad_section_path_is_refused() -> None:
     scene = closed_trefoil(16.37, nodes=60, contact="sectioned")
-    with pytest.raises(ValueError, match="section_path must be one of auto, final, full"):
+    with pytest.raises(ValueError, match="section_path must be one of auto, final, full, pull"):
         tie(scene, section_path="half")
 
 

@@ -243,7 +243,7 @@ def default_coarse_nodes(nodes: int) -> int | None:
     return REFINE_FROM if 2 * nodes > 3 * REFINE_FROM else None
 
 #: How a sectioned scene's load path runs (:func:`tightknot.loading.tie.path_scene`).
-SECTION_PATHS = ("auto", "final", "full")
+SECTION_PATHS = ("auto", "final", "full", "pull")
 
 
 @dataclass(frozen=True)
@@ -285,8 +285,10 @@ class LoadPath:
                               "pull at the compliant level, the sections' equilibrium solved "
                               "under the final load; an open knot's target Lambda_OC sought "
                               "again there), full (every load step with the sections: a "
-                              "pulled knot's equilibrium can depend on its path) or auto "
-                              "(final for a closed knot, full for an open one)")
+                              "pulled knot's equilibrium can depend on its path), pull "
+                              "(relax and tighten at the compliant level, then the sections "
+                              "added and the knot pulled with them) or auto (final for a "
+                              "closed knot, full for an open one)")
     # A setting of the sectioned level beside its path, not a scene parameter: sweeps run
     # without it, so their case ids stay (tightknot/sweep/cases.py, NOT_CASE_KEYS).
     section_bend_shift: bool = param(False, None, "",

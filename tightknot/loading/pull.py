@@ -25,6 +25,7 @@ from tightknot.loading.tie import (
     end_reaction,
     knot_type_of,
     path_scene,
+    resolved_path,
     section_finish,
     tie,
 )
@@ -111,6 +112,8 @@ def tie_to_lambda(
     path_scene`; "auto" pulls an open knot with its sections) runs all this at the
     compliant level, then solves the sections' equilibrium at the force found there and
     searches the force again from it: the sections change the knot length a force gives.
+    With "pull" the knot is relaxed and tightened at the compliant level, and the force is
+    sought with the sections from their equilibrium at the tightened knot.
     """
     if scene.closed:
         raise ValueError("tie_to_lambda is for open knots")
@@ -119,18 +122,25 @@ def tie_to_lambda(
     search = SearchOptions(tolerance=tolerance, step_ratio=force_ratio,
                            max_steps=max_force_steps, retries=3, refine="bisection")
     via = path_scene(scene, section_path)
-    return Program(_tie_to_lambda(scene, via, target, search, residual_tol, hook),
-                   "tie_to_lambda")
+    return Program(_tie_to_lambda(scene, via, target, search, residual_tol, hook,
+                                  section_path), "tie_to_lambda")
 
 
 def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: SearchOptions,
-                   residual_tol: float, hook: StepHook | None) -> Coroutine[TieResult]:
+                   residual_tol: float, hook: StepHook | None,
+                   section_path: str) -> Coroutine[TieResult]:
     """The coroutine of :func:`tie_to_lambda` (its arguments checked; the load path on
     ``via``, :func:`tightknot.loading.tie.path_scene`)."""
     res = yield from tie(via, tighten_steps=40, residual_tol=residual_tol, hook=hook,
                          section_path="full")
     if not res.converged:
         return res
+    if via is not scene and resolved_path(scene, section_path) == "pull":
+        # the sections join the tightened knot; the force is sought with them
+        res = yield from section_finish(scene, res, residual_tol, hook)
+        if not res.converged:
+            return res
+        return (yield from _seek(scene, res, target, search, residual_tol, hook))
     res = yield from _seek(via, res, target, search, residual_tol, hook)
     if via is scene or not res.converged:
         return res

@@ -163,6 +163,8 @@ def tie(
         section_path: a sectioned scene's load path (:func:`path_scene`): "final" runs it
             at the compliant level and solves the sections' equilibrium under its last
             load (:func:`section_finish`); "full" runs every step with the sections;
+            "pull" relaxes and tightens at the compliant level, solves the sections'
+            equilibrium there and pulls with them ("final" where nothing is pulled);
             "auto": "final" for a closed knot, "full" for an open one.
     """
     if scene.contact is None:
@@ -180,18 +182,36 @@ def tie(
     if via is not scene and attach is not None:
         raise ValueError(f"{scene.name}: contact='sectioned' is tied one rod at a time (a "
                          "batch's banded systems hold no section dofs)")
+    pulled = pull_force is not None or end_distance is not None
+    sections = (scene if via is not scene and pulled
+                and resolved_path(scene, section_path) == "pull" else None)
     body = _tie(via, pull_force, end_distance, tighten_steps, pull_steps, residual_tol,
-                hold_force_scale, relax_iterations, hook, attach, start_state, knot_type)
-    if via is not scene:
+                hold_force_scale, relax_iterations, hook, attach, start_state, knot_type,
+                sections)
+    if via is not scene and sections is None:
         body = _then_sections(scene, body, end_distance is not None, residual_tol, hook,
                               knot_type)
     return Program(body, "tie")
 
 
+def resolved_path(scene: KnotScene, section_path: str = LoadPath.section_path) -> str:
+    """``section_path`` ("auto", "final", "full" or "pull") as it runs on ``scene``:
+    "auto" is "final" for a closed knot and "full" for an open one; "pull" is "final" for a
+    closed knot (nothing is pulled)."""
+    if section_path not in SECTION_PATHS:
+        raise ValueError(f"section_path must be one of {', '.join(SECTION_PATHS)}, got "
+                         f"{section_path!r}")
+    if section_path == "auto":
+        return "final" if scene.closed else "full"
+    if section_path == "pull" and scene.closed:
+        return "final"
+    return section_path
+
+
 def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> KnotScene:
     """The scene a load path of ``scene`` runs on: ``scene`` itself, but for a sectioned
-    scene with ``section_path`` "final" (or "auto" and a closed knot) the same rod and
-    start at the compliant level.
+    scene with ``section_path`` "final" or "pull" (or "auto" and a closed knot) the same
+    rod and start at the compliant level ("pull": up to the end of the tightening).
 
     The sections matter where the knot is tight; on the way there (the start's relaxation,
     the tightening) the compliant level keeps the same centerline guarantees (the step
@@ -200,12 +220,8 @@ def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> K
     it either way, as the closed trefoil does; a pulled open knot can have two, and the
     way there picks one, so "auto" pulls an open knot with its sections all the way
     (docs/sectioned_level.md measures both)."""
-    if section_path not in SECTION_PATHS:
-        raise ValueError(f"section_path must be one of {', '.join(SECTION_PATHS)}, got "
-                         f"{section_path!r}")
-    if section_path == "auto":
-        section_path = "final" if scene.closed else "full"
-    if section_path == "full" or not isinstance(scene.contact, SectionedLayer):
+    if resolved_path(scene, section_path) == "full" or not isinstance(scene.contact,
+                                                                     SectionedLayer):
         return scene
     return dataclasses.replace(scene, contact=contact_layer(scene.model, "compliant"),
                                rebuild=None)
@@ -278,8 +294,11 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
          tighten_steps: int, pull_steps: int, residual_tol: float, hold_force_scale: float,
          relax_iterations: int, hook: StepHook | None,
          attach: Callable[[RodSystem], None] | None, start_state: State | None,
-         knot_type: Callable[[KnotScene, np.ndarray], str]) -> Coroutine[TieResult]:
-    """The coroutine of :func:`tie` (its arguments checked)."""
+         knot_type: Callable[[KnotScene, np.ndarray], str],
+         sections: KnotScene | None = None) -> Coroutine[TieResult]:
+    """The coroutine of :func:`tie` (its arguments checked); with ``sections`` (the
+    sectioned scene of the same rod, section_path "pull"), the pull runs on it from the
+    sections' equilibrium at the tightened knot."""
     start = time.perf_counter()
     types: list[str] = []
     phases: dict[str, StaticResult] = {}
@@ -351,6 +370,17 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
     if scene.closed or (pull_force is None and end_distance is None):
         return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                          hold if not scene.closed else 0.0, system)
+
+    if sections is not None:
+        # section_path "pull": the sections join the tightened knot, whose equilibrium
+        # with them under the tightening's last load starts the pull.
+        done = TieResult(True, "", phases, iters, time.perf_counter() - start, types,
+                         hold, system)
+        res = yield from section_finish(sections, done, residual_tol, hook, knot_type)
+        if not res.converged:
+            return res
+        phases, iters, types = dict(res.phases), res.newton_iterations, list(res.knot_types)
+        scene, system = sections, res.system
 
     # Phase 2: pull. The end's force at the tightened equilibrium, then the knot centred
     # on its rod.
