@@ -27,6 +27,7 @@ from tightknot.knots.scenes import (
     open_trefoil,
     vertex_radii,
 )
+from tightknot.loading.options import SECTION_PATHS
 from tightknot.loading.pull import tie_to_lambda
 from tightknot.loading.tie import tie
 
@@ -92,7 +93,7 @@ def main() -> None:
     parser.add_argument("--levels", nargs="+", default=["compliant", "smoothed"],
                         choices=["compliant", "smoothed", "sectioned", "sectioned-shift",
                                  "sectioned-rod", "rigid"])
-    parser.add_argument("--section-path", default="auto", choices=["auto", "final", "full"],
+    parser.add_argument("--section-path", default="auto", choices=list(SECTION_PATHS),
                         help="the sectioned level's load path (tightknot.loading.tie.path_scene)")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()

@@ -14,7 +14,7 @@ from tightknot.contact.sectioned import SectionedLayer, SectionSettings
 from tightknot.knots.scenes import closed_trefoil, open_trefoil
 from tightknot.loading.batch import tie_batch
 from tightknot.loading.pull import knot_length, tie_to_lambda
-from tightknot.loading.tie import path_scene, tie
+from tightknot.loading.tie import path_scene, resolved_path, tie
 from tightknot.study.run import calibration_range, run_knot
 
 
@@ -171,15 +171,17 @@ def test_a_bad_section_path_is_refused() -> None:
 
 def test_auto_pulls_an_open_knot_with_its_sections() -> None:
     """section_path "auto" (the default): a closed knot's load path runs at the compliant
-    level, an open knot is pulled with its sections (a pulled knot can have two
-    equilibria, and the way there picks one: docs/sectioned_level.md)."""
+    level, an open knot is tightened there and pulled with its sections (a pulled knot
+    can have two equilibria, and the way there picks one: docs/sectioned_level.md)."""
     closed = closed_trefoil(16.37, nodes=60, contact="sectioned")
     opened = open_trefoil(0.125, nodes=100, contact="sectioned")
     via = path_scene(closed)
     assert via is not closed and not isinstance(via.contact, SectionedLayer)
     assert via.model is closed.model
-    assert path_scene(opened) is opened
-    assert path_scene(opened, "final") is not opened
+    assert resolved_path(closed) == "final" and resolved_path(closed, "pull") == "final"
+    assert resolved_path(opened) == "pull"
+    assert not isinstance(path_scene(opened).contact, SectionedLayer)
+    assert path_scene(opened, "full") is opened
     assert path_scene(closed, "full") is closed
 
 

@@ -288,7 +288,7 @@ class LoadPath:
                               "pulled knot's equilibrium can depend on its path), pull "
                               "(relax and tighten at the compliant level, then the sections "
                               "added and the knot pulled with them) or auto (final for a "
-                              "closed knot, full for an open one)")
+                              "closed knot, pull for an open one)")
     # A setting of the sectioned level beside its path, not a scene parameter: sweeps run
     # without it, so their case ids stay (tightknot/sweep/cases.py, NOT_CASE_KEYS).
     section_bend_shift: bool = param(False, None, "",

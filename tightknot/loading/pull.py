@@ -109,11 +109,11 @@ def tie_to_lambda(
     where it fails).
 
     A sectioned scene with ``section_path`` "final" (:func:`tightknot.loading.tie.
-    path_scene`; "auto" pulls an open knot with its sections) runs all this at the
-    compliant level, then solves the sections' equilibrium at the force found there and
-    searches the force again from it: the sections change the knot length a force gives.
-    With "pull" the knot is relaxed and tightened at the compliant level, and the force is
-    sought with the sections from their equilibrium at the tightened knot.
+    path_scene`) runs all this at the compliant level, then solves the sections'
+    equilibrium at the force found there and searches the force again from it: the
+    sections change the knot length a force gives. With "pull" (and "auto") the knot is
+    relaxed and tightened at the compliant level, and the force is sought with the
+    sections from their equilibrium at the tightened knot; with "full", all with them.
     """
     if scene.closed:
         raise ValueError("tie_to_lambda is for open knots")

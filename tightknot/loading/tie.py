@@ -165,7 +165,7 @@ def tie(
             load (:func:`section_finish`); "full" runs every step with the sections;
             "pull" relaxes and tightens at the compliant level, solves the sections'
             equilibrium there and pulls with them ("final" where nothing is pulled);
-            "auto": "final" for a closed knot, "full" for an open one.
+            "auto": "final" for a closed knot, "pull" for an open one.
     """
     if scene.contact is None:
         raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
@@ -196,13 +196,13 @@ def tie(
 
 def resolved_path(scene: KnotScene, section_path: str = LoadPath.section_path) -> str:
     """``section_path`` ("auto", "final", "full" or "pull") as it runs on ``scene``:
-    "auto" is "final" for a closed knot and "full" for an open one; "pull" is "final" for a
+    "auto" is "final" for a closed knot and "pull" for an open one; "pull" is "final" for a
     closed knot (nothing is pulled)."""
     if section_path not in SECTION_PATHS:
         raise ValueError(f"section_path must be one of {', '.join(SECTION_PATHS)}, got "
                          f"{section_path!r}")
     if section_path == "auto":
-        return "final" if scene.closed else "full"
+        return "final" if scene.closed else "pull"
     if section_path == "pull" and scene.closed:
         return "final"
     return section_path
@@ -210,16 +210,18 @@ def resolved_path(scene: KnotScene, section_path: str = LoadPath.section_path) -
 
 def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> KnotScene:
     """The scene a load path of ``scene`` runs on: ``scene`` itself, but for a sectioned
-    scene with ``section_path`` "final" or "pull" (or "auto" and a closed knot) the same
-    rod and start at the compliant level ("pull": up to the end of the tightening).
+    scene with ``section_path`` "final", "pull" or "auto" the same rod and start at the
+    compliant level ("pull", and "auto" for an open knot: up to the end of the tightening).
 
     The sections matter where the knot is tight; on the way there (the start's relaxation,
     the tightening) the compliant level keeps the same centerline guarantees (the step
-    bound and the proximity check act on the centerlines at both levels) at a tenth of the
+    bound and the proximity check act on the centerlines at both levels) at a fifth of the
     cost per Newton iteration. A knot with one equilibrium under the final load reaches
     it either way, as the closed trefoil does; a pulled open knot can have two, and the
-    way there picks one, so "auto" pulls an open knot with its sections all the way
-    (docs/sectioned_level.md measures both)."""
+    way there picks one: sections added only under the final force ("final") can settle
+    on the other, so "auto" adds them at the tightened knot and pulls with them ("pull"),
+    which reaches the knot of a path with the sections all the way ("full")
+    (docs/sectioned_level.md measures the three)."""
     if resolved_path(scene, section_path) == "full" or not isinstance(scene.contact,
                                                                      SectionedLayer):
         return scene
