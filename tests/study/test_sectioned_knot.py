@@ -98,41 +98,26 @@ def test_the_final_path_reaches_the_full_paths_equilibrium() -> None:
     assert res_final.system.state.extra.size == runs["final"][0].contact.dof_count
 
 
-def test_an_open_knot_is_sought_again_at_the_sectioned_level() -> None:
-    """tie_to_lambda with section_path "final": the knot length the compliant level's
-    force gives moves once the sections take the contact, and the force is sought again
-    with them (125 mm rod at 100 vertices to Lambda_OC 12: 12.16 after the handover,
-    then 11.99)."""
+@pytest.mark.parametrize(("path", "before"), [("final", {"tighten", "pull"}),
+                                              ("pull", {"tighten"})])
+def test_an_open_knot_is_sought_with_its_sections(path: str, before: set[str]) -> None:
+    """tie_to_lambda on the paths that hand an open knot over to its sections (125 mm rod
+    at 100 vertices to Lambda_OC 12). "final": the force sought at the compliant level,
+    the sections' equilibrium under it (12.16), then the force sought again with them
+    (11.99). "pull": the relaxation and the tightening at the compliant level, the
+    sections' equilibrium at the tightened knot, then the force sought with them (12.05;
+    a pull to a force on this path: the slow test below). From the handover on, every
+    equilibrium carries the sections."""
     scene = open_trefoil(0.125, nodes=100, contact="sectioned")
     calls: list[tuple[str, int]] = []
-    res = tie_to_lambda(scene, 12.0, section_path="final", hook=lambda phase, system, rec:
-                        calls.append((phase, system.state.extra.size))).run()
-    assert res.converged, res.failure
-    assert set(res.knot_types) == {"3_1"}
-    assert knot_length(scene, res.system) == pytest.approx(12.0, abs=0.1)
-    phases = [c[0] for c in calls]
-    assert "section" in phases
-    after = calls[phases.index("section"):]
-    # from the handover on, every equilibrium carries the sections
-    assert all(size == scene.contact.dof_count for _, size in after)
-    assert all(size == 0 for _, size in calls[:phases.index("section")])
-
-
-def test_the_pull_path_tightens_at_the_compliant_level_and_seeks_with_sections() -> None:
-    """tie_to_lambda with section_path "pull": the relaxation and the tightening at the
-    compliant level, then the sections' equilibrium at the tightened knot, and the force
-    sought with them (125 mm rod at 100 vertices to Lambda_OC 12: 12.05). A pull to a
-    force (tie) on this path: the slow test below."""
-    scene = open_trefoil(0.125, nodes=100, contact="sectioned")
-    calls: list[tuple[str, int]] = []
-    res = tie_to_lambda(scene, 12.0, section_path="pull", hook=lambda phase, system, rec:
+    res = tie_to_lambda(scene, 12.0, section_path=path, hook=lambda phase, system, rec:
                         calls.append((phase, system.state.extra.size))).run()
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     assert knot_length(scene, res.system) == pytest.approx(12.0, abs=0.1)
     phases = [c[0] for c in calls]
     first = phases.index("section")
-    assert set(phases[:first]) == {"tighten"} and phases.count("section") == 1
+    assert set(phases[:first]) == before and phases.count("section") == 1
     assert "pull" in phases[first:]
     assert all(size == 0 for _, size in calls[:first])
     assert all(size == scene.contact.dof_count for _, size in calls[first:])
