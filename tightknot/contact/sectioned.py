@@ -555,15 +555,17 @@ class SectionedLayer(ContactLayer):
 
         def run(i: int) -> None:
             lo, hi = chunks[i]
-            part = (lambda a, per: a[per * lo:per * hi]) if len(chunks) > 1 else (
-                lambda a, per: a)
+
+            def part(a: wp.array, per: int, used: bool = True) -> wp.array:
+                # chunk i's view of a per-pair array (an unused one is a 1-entry stub)
+                return a[per * lo:per * hi] if used else a
+
             wp.launch(kernel, 2 * (hi - lo),
                       [*self._model_args, wx, *data, self._vertex_amp, self._edge_rbase,
-                       part(buf, 1), part(w_slots, 16) if derivatives else w_slots],
-                      [part(energy, 2), part(grad, 2 * nl) if derivatives else grad, blocks[i],
-                       part(s_pen, 2 * ns) if report else s_pen,
-                       part(s_wt, 2 * ns) if report else s_wt,
-                       part(dlam, 4) if with_lam else dlam], device=dev)
+                       part(buf, 1), part(w_slots, 16, derivatives)],
+                      [part(energy, 2), part(grad, 2 * nl, derivatives), blocks[i],
+                       part(s_pen, 2 * ns, report), part(s_wt, 2 * ns, report),
+                       part(dlam, 4, with_lam)], device=dev)
 
         if len(chunks) > 1 and kernel.key in self._launched:
             pending = [_chunk_pool().submit(run, i) for i in range(1, len(chunks))]
