@@ -18,9 +18,10 @@ venv: $(BIN)/tightknot
 demo: venv
 	$(BIN)/tightknot demo --out runs/demo --overwrite
 
-# CI and `make test`: everything but the long checks (marked slow: the FEM's fine meshes).
+# CI and `make test`: everything but the long checks (marked slow: the FEM's fine meshes),
+# on two workers (pytest-xdist), the cores CI has: Warp's CPU kernels run on one thread.
 test: venv
-	$(BIN)/python -m pytest -q -m "not slow"
+	$(BIN)/python -m pytest -q -m "not slow" -n 2
 
 test-slow: venv
 	$(BIN)/python -m pytest -q -m slow
