@@ -118,6 +118,9 @@ class SparseDirect:
     """The Newton loop's linear algebra for a Hessian held as a scipy CSC matrix: shifted
     systems ``(H + mu D) d = -g`` solved by :func:`factorize` (SuperLU)."""
 
+    #: The solver's name in run summaries.
+    name = "superlu"
+
     @staticmethod
     def matrix(h: sp.csc_matrix | LowRankHessian) -> object:
         """The Hessian as an operator for products (a sparse matrix, or with a low-rank

@@ -58,6 +58,9 @@ class BandedSolver:
         stats: where its factorizations are counted (shared by a rod's phases).
     """
 
+    #: The solver's name in run summaries.
+    name = "banded"
+
     #: Largest n bw^2 (dofs times half-bandwidth squared) solved in band storage: banded
     #: LU costs about 4 n bw^2 flops; a band of a few distant contacts of a loose knot
     #: costs more than SuperLU.

@@ -28,6 +28,7 @@ from tightknot.rods.staging import Output
 from tightknot.rods.state import State
 from tightknot.rods.term import BlockHessian, EnergyTerm
 from tightknot.solvers.linear import LowRankHessian, SparseDirect
+from tightknot.solvers.pardiso import section_linear
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
 
 
@@ -148,6 +149,9 @@ class RodSystem:
             self.dof_term = term
             if self.state.extra.shape != (term.dof_count,):
                 self.state.extra = term.initial_dofs()
+            # Section dofs make dense node blocks, which a supernodal LDL^T factors
+            # several times faster than SuperLU (tightknot.solvers.pardiso).
+            self.linear = section_linear()
         self.extra_terms.append(term)
         term.begin_load_step(self.state.x, self.rest)
         if term.keeps_apart and self.proximity is None:

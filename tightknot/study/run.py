@@ -176,6 +176,9 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         "alexander_at_minus1": rep["knot_determinant"],
         "newton_iterations": res.newton_iterations,
         "wall_time_s": res.wall_time_s,
+        # which library solved the Newton systems (the sectioned level's: PARDISO where
+        # installed), since round-off can pick between a knot's nearby equilibria
+        "linear_solver": getattr(res.system.linear, "name", "superlu"),
         "nodes": scene.model.vertex_count,
         "diameter_m": scene.diameter,
         "rest_length_m": scene.rest_length,

@@ -1,0 +1,258 @@
+"""Intel MKL PARDISO for the sectioned level's Newton systems: a supernodal symmetric
+indefinite LDL^T whose ordering and symbolic analysis are kept while the matrix's pattern
+stays.
+
+The sectioned level's Hessians are made of dense node blocks (a node's position and section
+dofs, coupled to its neighbours' and its contact partners'), where a supernodal
+factorization runs on dense kernels: MKL PARDISO, matrix type -2 (real symmetric
+indefinite, Bunch-Kaufman pivoting within supernodes and pivot perturbation; Schenk &
+Gaertner, FGCS 20 (2004) 475), factors them several times faster than SciPy's SuperLU
+(docs/sectioned_level.md, "Cost"). Its analysis (nested-dissection ordering and symbolic
+factorization) costs several factorizations, so :class:`PardisoDirect` keeps it while the
+pattern of the matrix is unchanged, and keeps the ordering when only contact blocks come
+and go (the symbolic factorization is then redone on that ordering).
+
+PARDISO runs on one thread here: its result then does not depend on the thread count
+(MKL's conditional numerical reproducibility), and the workers of a sweep or a test run
+each have a core. ``pypardiso`` (BSD) loads MKL's runtime (the ``mkl`` wheel, x86_64 only;
+both in the ``fem`` extra); without it the sectioned level solves with SuperLU as the
+others do (:class:`tightknot.solvers.linear.SparseDirect`).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import glob
+import os
+import sys
+import weakref
+from functools import cache
+
+import numpy as np
+import scipy.sparse as sp
+
+from tightknot.solvers.linear import LowRankHessian, SparseDirect, woodbury_solve
+
+#: Environment variable that picks the sectioned level's linear solver.
+ENV_VAR = "TIGHTKNOT_SECTION_SOLVER"
+#: Its values: "auto" (PARDISO where installed, else SuperLU), "pardiso", "superlu".
+SOLVERS = ("auto", "pardiso", "superlu")
+
+
+@cache
+def _library() -> ctypes.CDLL | None:
+    """MKL's runtime (the ``mkl`` wheel's, else where pypardiso finds it), with the
+    pardiso entry point typed; None when pypardiso or MKL is not installed."""
+    try:
+        import pypardiso  # noqa: F401  (the supported way in: its presence says MKL's)
+    except ImportError:
+        return None
+    lib = None
+    # The wheel's library sits in the environment's lib/; pypardiso's own search walks
+    # the whole environment (a second per process).
+    for path in sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*"))):
+        try:
+            lib = ctypes.CDLL(path)
+            break
+        except OSError:
+            continue
+    if lib is None:
+        try:
+            lib = pypardiso.PyPardisoSolver().libmkl
+        except (ImportError, OSError):
+            return None
+    f = lib.pardiso
+    i32 = ctypes.POINTER(ctypes.c_int32)
+    f.argtypes = [ctypes.POINTER(ctypes.c_int64), i32, i32, i32, i32, i32,
+                  ctypes.c_void_p, i32, i32, i32, i32, i32, i32, ctypes.c_void_p,
+                  ctypes.c_void_p, i32]
+    f.restype = None
+    lib.MKL_Set_Num_Threads_Local.argtypes = [ctypes.c_int]
+    lib.MKL_Set_Num_Threads_Local.restype = ctypes.c_int
+    return lib
+
+
+def available() -> bool:
+    """Whether MKL PARDISO can be loaded here."""
+    return _library() is not None
+
+
+def section_solver(name: str | None = None) -> str:
+    """The solver the sectioned level uses: ``name`` or the environment's
+    ``TIGHTKNOT_SECTION_SOLVER`` (default "auto": "pardiso" where installed, else
+    "superlu"); ValueError for an unknown name, ImportError for "pardiso" without MKL."""
+    name = os.environ.get(ENV_VAR, "auto") if name is None else name
+    if name not in SOLVERS:
+        raise ValueError(f"{ENV_VAR} must be one of {SOLVERS}, got {name!r}")
+    if name == "auto":
+        return "pardiso" if available() else "superlu"
+    if name == "pardiso" and not available():
+        raise ImportError("the sectioned level's solver 'pardiso' needs pypardiso and MKL "
+                          "(pip install 'tightknot[fem]' on x86_64)")
+    return name
+
+
+def section_linear() -> SparseDirect:
+    """The linear algebra of a rod system with section dofs: :class:`PardisoDirect` or
+    SuperLU's :class:`~tightknot.solvers.linear.SparseDirect` (:func:`section_solver`)."""
+    return PardisoDirect() if section_solver() == "pardiso" else SparseDirect()
+
+
+class _Handle:
+    """One PARDISO instance (its internal memory ``pt``), freed with the object."""
+
+    def __init__(self, lib: ctypes.CDLL) -> None:
+        self.lib = lib
+        self.pt = np.zeros(64, dtype=np.int64)
+        self.iparm = np.zeros(64, dtype=np.int32)
+        ip = self.iparm
+        ip[0] = 1    # these settings, not the defaults
+        ip[1] = 2    # nested dissection (METIS) ordering
+        ip[7] = 2    # at most two steps of iterative refinement after perturbed pivots
+        ip[9] = 8    # perturb pivots below 1e-8 of the norm (the default for type -2)
+        ip[20] = 1   # Bunch-Kaufman 1x1 and 2x2 pivoting (the default for type -2)
+        ip[23] = 0   # the classic factorization, whose result is the same on any threads
+        ip[34] = 1   # zero-based ia and ja
+        self.n = 0
+        self._finalizer = weakref.finalize(self, _release, lib, self.pt)
+
+    def call(self, phase: int, a: sp.csr_matrix, perm: np.ndarray, b: np.ndarray,
+             x: np.ndarray) -> int:
+        err = ctypes.c_int32(0)
+        i32 = ctypes.c_int32
+        # one thread for this call only (a thread-local setting, restored after it)
+        previous = self.lib.MKL_Set_Num_Threads_Local(1)
+        try:
+            self.lib.pardiso(
+                self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)),
+                ctypes.byref(i32(1)), ctypes.byref(i32(1)), ctypes.byref(i32(-2)),
+                ctypes.byref(i32(phase)), ctypes.byref(i32(a.shape[0])),
+                a.data.ctypes.data, a.indptr.ctypes.data_as(ctypes.POINTER(i32)),
+                a.indices.ctypes.data_as(ctypes.POINTER(i32)),
+                perm.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(1)),
+                self.iparm.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(0)),
+                b.ctypes.data, x.ctypes.data, ctypes.byref(err))
+        finally:
+            self.lib.MKL_Set_Num_Threads_Local(previous)
+        return int(err.value)
+
+
+def _release(lib: ctypes.CDLL, pt: np.ndarray) -> None:
+    """PARDISO phase -1: free all its memory of the instance ``pt``."""
+    if not pt.any():
+        return
+    i32 = ctypes.c_int32
+    dummy = np.zeros(1, dtype=np.float64)
+    idx = np.zeros(2, dtype=np.int32)
+    iparm = np.zeros(64, dtype=np.int32)
+    err = ctypes.c_int32(0)
+    lib.pardiso(pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ctypes.byref(i32(1)),
+                ctypes.byref(i32(1)), ctypes.byref(i32(-2)), ctypes.byref(i32(-1)),
+                ctypes.byref(i32(1)), dummy.ctypes.data,
+                idx.ctypes.data_as(ctypes.POINTER(i32)),
+                idx.ctypes.data_as(ctypes.POINTER(i32)),
+                idx.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(1)),
+                iparm.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(0)),
+                dummy.ctypes.data, dummy.ctypes.data, ctypes.byref(err))
+
+
+class PardisoDirect(SparseDirect):
+    """The Newton loop's linear algebra (as :class:`~tightknot.solvers.linear.SparseDirect`)
+    with the shifted systems ``(H + mu D) d = -g`` factored by MKL PARDISO.
+
+    The matrix is equilibrated symmetrically, ``S A S`` with ``S = |diag A|^-1/2``, as
+    :class:`~tightknot.solvers.linear.Factorization` does, and PARDISO reads its upper
+    triangle. Its analysis is redone only when the pattern changes, on the kept ordering
+    while the size stays and the number of stored entries grew by less than
+    :attr:`REORDER_GROWTH` since the ordering was made.
+
+    Attributes:
+        analyses: symbolic analyses made; orderings: of them, with a new ordering;
+            factorizations: numeric factorizations (for benchmarks and tests).
+    """
+
+    name = "pardiso"
+
+    #: Relative growth of the upper triangle's entries past which the ordering is renewed
+    #: (a kept ordering of a denser pattern fills in more).
+    REORDER_GROWTH = 0.1
+
+    def __init__(self) -> None:
+        lib = _library()
+        if lib is None:
+            raise ImportError("MKL PARDISO is not installed (pypardiso and mkl)")
+        self._h = _Handle(lib)
+        self._key: tuple | None = None
+        self._perm = np.zeros(0, dtype=np.int32)
+        self._perm_nnz = 0
+        self.analyses = 0
+        self.orderings = 0
+        self.factorizations = 0
+
+    def shifted_direction(self, h: sp.csc_matrix | LowRankHessian, g: np.ndarray, mu: float,
+                          diag: np.ndarray) -> np.ndarray | None:
+        """Solve (H + mu D) d = -g with D = diag(``diag``); None when the factorization
+        fails or the result is not finite. A low-rank update is solved by
+        :func:`~tightknot.solvers.linear.woodbury_solve` around the sparse part."""
+        base = h.base if isinstance(h, LowRankHessian) else h
+        a = sp.csc_matrix(base)
+        if mu != 0.0:
+            a = a + sp.diags(mu * diag, format="csc")
+        solve = self._factorize(a)
+        if solve is None:
+            return None
+        d = (woodbury_solve(solve, h.u, h.c, -g) if isinstance(h, LowRankHessian)
+             else solve(-g))
+        return d if d is not None and np.isfinite(d).all() else None
+
+    def _factorize(self, a: sp.csc_matrix):
+        a.sum_duplicates()
+        d = np.abs(a.diagonal())
+        s = 1.0 / np.sqrt(np.where(d > 0.0, d, 1.0))
+        # The upper triangle in CSR is the lower one in CSC of the (symmetric) matrix.
+        low = sp.tril(a, format="csc")
+        low.sort_indices()
+        cols = np.repeat(np.arange(a.shape[1]), np.diff(low.indptr))
+        data = low.data * s[low.indices] * s[cols]
+        up = sp.csr_matrix((data, low.indices.astype(np.int32),
+                            low.indptr.astype(np.int32)), shape=a.shape)
+        n = a.shape[0]
+        key = (n, up.indptr.tobytes(), up.indices.tobytes())
+        h = self._h
+        dummy = np.zeros(n)
+        if key != self._key:
+            fresh = (n != h.n or up.nnz > (1.0 + self.REORDER_GROWTH) * self._perm_nnz)
+            if fresh:
+                self._perm = np.zeros(n, dtype=np.int32)
+                h.iparm[4] = 2  # make the ordering and return it in perm
+            else:
+                h.iparm[4] = 1  # the kept ordering
+            if h.n:
+                _release(h.lib, h.pt)
+                h.pt[:] = 0
+            if h.call(11, up, self._perm, dummy, dummy.copy()) != 0:
+                self._key = None
+                h.n = 0
+                return None
+            h.n = n
+            self._key = key
+            self.analyses += 1
+            if fresh:
+                self.orderings += 1
+                self._perm_nnz = up.nnz
+        if h.call(22, up, self._perm, dummy, dummy.copy()) != 0:
+            return None
+        self.factorizations += 1
+        h.iparm[4] = 0
+
+        def solve(b: np.ndarray) -> np.ndarray:
+            b = np.asarray(b, dtype=np.float64)
+            if b.ndim == 2:
+                return np.column_stack([solve(b[:, k]) for k in range(b.shape[1])])
+            rhs = np.ascontiguousarray(s * b)
+            x = np.zeros(n)
+            if h.call(33, up, self._perm, rhs, x) != 0:
+                return np.full(n, np.nan)
+            return s * x
+
+        return solve
