@@ -226,3 +226,30 @@ def test_a_solve_that_passed_through_is_refused_without_proximal_steps(monkeypat
     why = _run(path.solve(0.5))
     assert "passed_through" in why
     assert path.level == 0.0 and np.array_equal(system.state.x, start)
+
+
+def _inverse_stretch_at(force: float) -> float:
+    """The closed form's 1/lam under ``force`` [N]: lam^3 - (F / mu A0) lam^2 - 1 = 0."""
+    roots = np.roots([1.0, -force / MU_A0, 0.0, -1.0])
+    lam = max(r.real for r in roots if abs(r.imag) < 1e-12)
+    return 1.0 / lam
+
+
+def test_a_given_slope_makes_the_first_secant_step() -> None:
+    # The slope of 1/lam in log F over the step to the target: the first step lands on it,
+    # where the fixed first step (1.15) overshoots and the bracket is searched.
+    target_force = 2.0 * 1.08
+    target = _inverse_stretch_at(target_force)
+    slope = (target - _inverse_stretch_at(2.0)) / math.log(1.08)
+    search = SearchOptions(tolerance=1e-6, secant=True, retries=3, refine="bisection")
+    hinted = _path(ONE)
+    assert _run(hinted.seek(target, _inverse_stretch, search, slope)) == ""
+    assert hinted.solves == 2  # the start and the one secant step
+    assert hinted.level == pytest.approx(target_force, rel=1e-9)
+    plain = _path(ONE)
+    assert _run(plain.seek(target, _inverse_stretch, search)) == ""
+    assert plain.solves > 2
+    # a rising slope says nothing about a target Lambda_OC that falls with the level
+    rising = _path(ONE)
+    assert _run(rising.seek(target, _inverse_stretch, search, -slope)) == ""
+    assert rising.solves == plain.solves

@@ -288,6 +288,8 @@ class LevelPath:
         self.history: list[tuple[float, float]] = []
         #: (level, positions [m]) of the equilibrium before the current one.
         self._previous: tuple[float, np.ndarray] | None = None
+        #: dLambda_OC/dlog(level) given to :meth:`seek` for its first secant step.
+        self._slope_hint: float | None = None
 
     # -- one level -------------------------------------------------------------------------
     def solve(self, value: float) -> Coroutine[str]:
@@ -425,13 +427,18 @@ class LevelPath:
         return self.system.free_vector_at(x)
 
     # -- the search ------------------------------------------------------------------------
-    def seek(self, target: float, measure: Measure, search: SearchOptions) -> Coroutine[str]:
+    def seek(self, target: float, measure: Measure, search: SearchOptions,
+             slope: float | None = None) -> Coroutine[str]:
         """Move to the level at which Lambda_OC (``measure``) is ``target`` within the
         tolerance, from the current equilibrium; "" on success, else why not. Lambda_OC
         falls as the level rises: the level steps up from a knot longer than the target,
         down from a shorter one, until the target is bracketed, then the bracket is
         searched (``search``). Where it cannot come within the tolerance (Lambda_OC jumps
-        between contact sets), the tighter side's equilibrium is kept."""
+        between contact sets), the tighter side's equilibrium is kept. ``slope``: an
+        estimate of dLambda_OC/dlog(level) that a secant search (``search.secant``) steps
+        by while the path has measured fewer than two equilibria (e.g. a cheaper model's
+        slope at the same knot)."""
+        self._slope_hint = slope
         name, unit = self.options.name, self.options.unit
         lam = measure(self.system)
         if abs(lam - target) <= search.tolerance:
@@ -512,11 +519,17 @@ class LevelPath:
 
     def _secant_step(self, target: float, lam: float) -> float | None:
         """Log-level step to ``target`` predicted from the slope dLambda_OC/dlog(level) of
-        the last two equilibria measured on the path (None without a falling slope)."""
+        the last two equilibria measured on the path, or :meth:`seek`'s estimate before
+        there are two (None without a falling slope)."""
         pts = self.history[-2:]
-        if len(pts) < 2 or pts[0][0] == pts[1][0]:
+        if len(pts) < 2:
+            slope = self._slope_hint
+            if slope is None:
+                return None
+        elif pts[0][0] == pts[1][0]:
             return None
-        slope = (pts[1][1] - pts[0][1]) / (pts[1][0] - pts[0][0])
+        else:
+            slope = (pts[1][1] - pts[0][1]) / (pts[1][0] - pts[0][0])
         if not (math.isfinite(slope) and slope < 0):
             return None
         return (target - lam) / slope

@@ -3,6 +3,7 @@ Lambda_OC by searching the force."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -136,11 +137,19 @@ def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: Sear
     if not res.converged:
         return res
     if via is not scene and resolved_path(scene, section_path) == "pull":
-        # the sections join the tightened knot; the force is sought with them
+        # The sections join the tightened knot and the force is sought with them. Their
+        # solves cost several compliant ones, so the search's first step is a secant one
+        # on the compliant level's slope of Lambda_OC in log force at this knot.
+        t0 = time.perf_counter()
+        slope, iterations = yield from _compliant_slope(via, res, target, search.step_ratio,
+                                                        residual_tol)
+        res = dataclasses.replace(res, newton_iterations=res.newton_iterations + iterations,
+                                  wall_time_s=res.wall_time_s + time.perf_counter() - t0)
         res = yield from section_finish(scene, res, residual_tol, hook)
         if not res.converged:
             return res
-        return (yield from _seek(scene, res, target, search, residual_tol, hook))
+        return (yield from _seek(scene, res, target, dataclasses.replace(search, secant=True),
+                                 residual_tol, hook, slope=slope))
     res = yield from _seek(via, res, target, search, residual_tol, hook)
     if via is scene or not res.converged:
         return res
@@ -151,13 +160,38 @@ def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: Sear
     return (yield from _seek(scene, res, target, search, residual_tol, hook, pulled=True))
 
 
+def _compliant_slope(scene: KnotScene, res: TieResult, target: float, ratio: float,
+                     residual_tol: float) -> Coroutine[tuple[float | None, int]]:
+    """dLambda_OC/dlog(F) of the tied knot ``res`` of ``scene`` (a level without sections)
+    between the force its held end carries and ``ratio`` times that force as a dead load
+    (one static solve on a copy: ``res`` is left as it was), None where that solve fails
+    or the knot does not tighten, or where the knot is not longer than ``target`` (the
+    search then loosens it, by fixed steps: secant steps only pull harder); and the Newton
+    iterations it took."""
+    done = res.system
+    tied = RodSystem(scene.model, done.state.copy(), done.bcs)
+    tied.add_term(scene.contact)
+    tied.set_load(done.t)
+    options = LevelOptions(steps="one", proximal_dt=None,
+                           newton=NewtonOptions(residual_tol=residual_tol, max_iterations=60))
+    path = pull_path(scene, tied, options, knot_kept(scene, [], False))
+    f0, lam0 = path.level, knot_length(scene, path.system)
+    if not lam0 > target:
+        return None, 0
+    if (yield from path.solve(f0 * ratio)):
+        return None, path.iterations
+    slope = (knot_length(scene, path.system) - lam0) / math.log(ratio)
+    return (slope if math.isfinite(slope) and slope < 0 else None), path.iterations
+
+
 def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions,
-          residual_tol: float, hook: StepHook | None, pulled: bool = False
-          ) -> Coroutine[TieResult]:
+          residual_tol: float, hook: StepHook | None, pulled: bool = False,
+          slope: float | None = None) -> Coroutine[TieResult]:
     """From ``res`` (an open knot of ``scene`` in equilibrium), the pull whose Lambda_OC is
     ``target``: first the equilibrium under the force the end carries now, centred on its
     rod (unless ``pulled``: ``res`` is one under that dead force already), then the force
-    searched (``search``)."""
+    searched (``search``; ``slope``: :meth:`~tightknot.loading.levels.LevelPath.seek`'s
+    first estimate of dLambda_OC/dlog F)."""
     start = time.perf_counter()
     types = list(res.knot_types)
     # Every force is one static solve: the search itself retries a failed step.
@@ -175,5 +209,5 @@ def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions
         why = yield from path.solve(path.level)
         if why:
             return done(why)
-    why = yield from path.seek(target, lambda s: knot_length(scene, s), search)
+    why = yield from path.seek(target, lambda s: knot_length(scene, s), search, slope)
     return done(why)
