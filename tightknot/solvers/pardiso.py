@@ -183,7 +183,6 @@ class PardisoDirect(SparseDirect):
             raise ImportError("MKL PARDISO is not installed (pypardiso and mkl)")
         self._h = _Handle(lib)
         self._key: tuple | None = None
-        self._triangle_of: tuple | None = None
         self._perm = np.zeros(0, dtype=np.int32)
         self._perm_nnz = 0
         self.analyses = 0
@@ -196,52 +195,29 @@ class PardisoDirect(SparseDirect):
         fails or the result is not finite. A low-rank update is solved by
         :func:`~tightknot.solvers.linear.woodbury_solve` around the sparse part."""
         base = h.base if isinstance(h, LowRankHessian) else h
-        solve = self._factorize(base, mu, diag)
+        a = sp.csc_matrix(base)
+        if mu != 0.0:
+            a = a + sp.diags(mu * diag, format="csc")
+        solve = self._factorize(a)
         if solve is None:
             return None
         d = (woodbury_solve(solve, h.u, h.c, -g) if isinstance(h, LowRankHessian)
              else solve(-g))
         return d if d is not None and np.isfinite(d).all() else None
 
-    def _triangle(self, base: sp.spmatrix) -> tuple:
-        """The upper triangle of ``base`` as CSR arrays (indptr, indices, data, the rows of
-        the entries, the diagonal's places) and the pattern's key; kept for the Newton
-        loop's retries with another shift on the same matrix."""
-        if self._triangle_of is not None and self._triangle_of[0] is base:
-            return self._triangle_of[1]
-        a = sp.csc_matrix(base)
+    def _factorize(self, a: sp.csc_matrix):
         a.sum_duplicates()
-        n = a.shape[0]
-        # The lower triangle in CSC (rows >= column, sorted) is the upper one in CSR of the
-        # symmetric matrix, each column's first entry its diagonal when stored.
-        cols = np.repeat(np.arange(n, dtype=np.int32), np.diff(a.indptr))
-        keep = a.indices >= cols
-        indices = a.indices[keep].astype(np.int32)
-        rows = cols[keep]
-        indptr = np.zeros(n + 1, dtype=np.int32)
-        np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:])
-        first = np.minimum(indptr[:-1], max(len(indices) - 1, 0))
-        has_diag = (np.diff(indptr) > 0) & (indices[first] == np.arange(n))
-        key = (n, indptr.tobytes(), indices.tobytes())
-        out = (indptr, indices, a.data[keep], rows, first, has_diag, key)
-        self._triangle_of = (base, out)
-        return out
-
-    def _factorize(self, base: sp.spmatrix, mu: float, shift: np.ndarray):
-        indptr, indices, data, rows, first, has_diag, key = self._triangle(base)
-        n = len(indptr) - 1
-        if mu != 0.0 and not has_diag.all():
-            # a diagonal entry not stored: the shift adds it (a new pattern)
-            self._triangle_of = None
-            a = sp.csc_matrix(base) + sp.diags(mu * shift, format="csc")
-            return self._factorize(a, 0.0, shift)
-        data = data.copy() if mu != 0.0 else data
-        if mu != 0.0:
-            data[first] += mu * shift
-        d = np.where(has_diag, np.abs(data[first]), 0.0)
+        d = np.abs(a.diagonal())
         s = 1.0 / np.sqrt(np.where(d > 0.0, d, 1.0))
-        # symmetric equilibration S A S (linear.Factorization explains)
-        up = sp.csr_matrix((data * s[rows] * s[indices], indices, indptr), shape=(n, n))
+        # The upper triangle in CSR is the lower one in CSC of the (symmetric) matrix.
+        low = sp.tril(a, format="csc")
+        low.sort_indices()
+        cols = np.repeat(np.arange(a.shape[1]), np.diff(low.indptr))
+        data = low.data * s[low.indices] * s[cols]
+        up = sp.csr_matrix((data, low.indices.astype(np.int32),
+                            low.indptr.astype(np.int32)), shape=a.shape)
+        n = a.shape[0]
+        key = (n, up.indptr.tobytes(), up.indices.tobytes())
         h = self._h
         dummy = np.zeros(n)
         if key != self._key:
