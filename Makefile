@@ -10,7 +10,7 @@ export WARP_CACHE_PATH ?= $(CURDIR)/.warp_cache
 $(BIN)/tightknot: pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[fem,test,distributed,tables]"
+	$(BIN)/python -m pip install --quiet -e ".[fem,pardiso,test,distributed,tables]"
 	touch $(BIN)/tightknot
 
 venv: $(BIN)/tightknot
