@@ -48,8 +48,9 @@ from tightknot.solvers.continuation import (
     continuation,
     static_solve,
 )
-from tightknot.solvers.newton import NewtonOptions, newton
-from tightknot.solvers.program import Coroutine, Program
+from tightknot.solvers.dynamic import proximal
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton
+from tightknot.solvers.program import Coroutine, Evaluate, Program
 from tightknot.solvers.system import RodSystem
 
 StepHook = Callable[[str, RodSystem, StepRecord], None]
@@ -264,6 +265,21 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     r, iters, prox = yield from static_solve(
         system, dataclasses.replace(steps.newton, max_iterations=400), steps.proximal_dt,
         steps.proximal_steps, steps.newton)
+    if not r.converged and system.violation is None and r.reason != "passed_through":
+        # Newton from the round sections can leap into a far basin (single edges necking
+        # under their sections' thinning, docs/sectioned_level.md) from which proximal steps
+        # do not return: the sections settle again from the same start by proximal steps
+        # alone, which only ever descend.
+        system.state = start.copy()
+        again = yield from proximal(system, steps.proximal_dt, steps.proximal_steps,
+                                    steps.newton)
+        iters += again.newton_iterations
+        prox = f"{prox}; from the start again: {again.reason}"
+        if again.converged:
+            _, g, _ = yield Evaluate(system, system.free_vector(), True, False)
+            r = NewtonResult(True, r.iterations + again.newton_iterations,
+                             system.residual_norm(g), 0.0, system.last_split.total,
+                             "converged_by_proximal_steps", r.history)
     why = ""
     if not r.converged:
         why = f"Newton {r.reason}" + (f", then proximal steps {prox}" if prox else
