@@ -288,8 +288,6 @@ class LevelPath:
         self.history: list[tuple[float, float]] = []
         #: (level, positions [m]) of the equilibrium before the current one.
         self._previous: tuple[float, np.ndarray] | None = None
-        #: dLambda_OC/dlog(level) given to :meth:`seek` for its first secant step.
-        self._slope_hint: float | None = None
 
     # -- one level -------------------------------------------------------------------------
     def solve(self, value: float) -> Coroutine[str]:
@@ -438,7 +436,6 @@ class LevelPath:
         estimate of dLambda_OC/dlog(level) that a secant search (``search.secant``) steps
         by while the path has measured fewer than two equilibria (e.g. a cheaper model's
         slope at the same knot)."""
-        self._slope_hint = slope
         name, unit = self.options.name, self.options.unit
         lam = measure(self.system)
         if abs(lam - target) <= search.tolerance:
@@ -448,7 +445,7 @@ class LevelPath:
         f_prev, lam_prev = self.level, lam
         ratio = search.step_ratio
         for _ in range(search.max_steps):
-            f = self._search_step(f_prev, lam_prev, target, up, ratio, search)
+            f = self._search_step(f_prev, lam_prev, target, up, ratio, search, slope)
             why = yield from self.move_to(f)
             if why and ratio > search.step_ratio ** (0.5 ** search.retries):
                 ratio = math.sqrt(ratio)
@@ -501,13 +498,13 @@ class LevelPath:
                 f"{unit})")
 
     def _search_step(self, f_prev: float, lam_prev: float, target: float, up: bool,
-                     ratio: float, search: SearchOptions) -> float:
-        """The level of the next bracketing step from ``f_prev``."""
+                     ratio: float, search: SearchOptions, slope: float | None) -> float:
+        """The level of the next bracketing step from ``f_prev`` (``slope``: :meth:`seek`'s)."""
         if not search.secant:
             return f_prev * (ratio if up else 1.0 / ratio)
         # Secant steps only when pulling harder (SecantPredictor.falling: loosening nears
         # the slip).
-        step = self._secant_step(target, lam_prev) if up else None
+        step = self._secant_step(target, lam_prev, slope) if up else None
         if step is None or (step > 0) != up:
             step = math.log(ratio)
         step = min(max(abs(step), math.log(search.min_step_ratio)), math.log(ratio))
@@ -517,13 +514,13 @@ class LevelPath:
         if math.isfinite(lam):
             self.history.append((math.log(self.level), lam))
 
-    def _secant_step(self, target: float, lam: float) -> float | None:
+    def _secant_step(self, target: float, lam: float, estimate: float | None) -> float | None:
         """Log-level step to ``target`` predicted from the slope dLambda_OC/dlog(level) of
-        the last two equilibria measured on the path, or :meth:`seek`'s estimate before
-        there are two (None without a falling slope)."""
+        the last two equilibria measured on the path, or from ``estimate`` before there are
+        two (None without a falling slope)."""
         pts = self.history[-2:]
         if len(pts) < 2:
-            slope = self._slope_hint
+            slope = estimate
             if slope is None:
                 return None
         elif pts[0][0] == pts[1][0]:

@@ -28,6 +28,7 @@ from tightknot.loading.tie import (
     path_scene,
     resolved_path,
     section_finish,
+    system_at,
     tie,
 )
 from tightknot.solvers.continuation import StepRecord
@@ -168,10 +169,7 @@ def _compliant_slope(scene: KnotScene, res: TieResult, target: float, ratio: flo
     or the knot does not tighten, or where the knot is not longer than ``target`` (the
     search then loosens it, by fixed steps: secant steps only pull harder); and the Newton
     iterations it took."""
-    done = res.system
-    tied = RodSystem(scene.model, done.state.copy(), done.bcs)
-    tied.add_term(scene.contact)
-    tied.set_load(done.t)
+    tied = system_at(scene, res.system)
     options = LevelOptions(steps="one", proximal_dt=None,
                            newton=NewtonOptions(residual_tol=residual_tol, max_iterations=60))
     path = pull_path(scene, tied, options, knot_kept(scene, [], False))

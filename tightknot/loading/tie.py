@@ -46,11 +46,11 @@ from tightknot.solvers.continuation import (
     StaticResult,
     StepRecord,
     continuation,
+    descend,
     static_solve,
 )
-from tightknot.solvers.dynamic import proximal
-from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton
-from tightknot.solvers.program import Coroutine, Evaluate, Program
+from tightknot.solvers.newton import NewtonOptions, newton
+from tightknot.solvers.program import Coroutine, Program
 from tightknot.solvers.system import RodSystem
 
 StepHook = Callable[[str, RodSystem, StepRecord], None]
@@ -241,6 +241,18 @@ def _then_sections(scene: KnotScene, path: Coroutine[TieResult], end_held: bool,
     return (yield from section_finish(scene, res, residual_tol, hook, knot_type, end_held))
 
 
+def system_at(scene: KnotScene, done: RodSystem, history: bool = False) -> RodSystem:
+    """A rod system of ``scene`` (its contact) at the state, boundary conditions and load
+    of ``done``, another level's system of the same rod; the state a copy, so that
+    ``done`` is left as it was. ``history``: it records its accepted positions."""
+    system = RodSystem(scene.model, done.state.copy(), done.bcs)
+    system.add_term(scene.contact)
+    if history:
+        system.history = []
+    system.set_load(done.t)
+    return system
+
+
 def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
                    hook: StepHook | None = None,
                    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
@@ -254,10 +266,7 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     failed solve's end in ``failed_state``."""
     t0 = time.perf_counter()
     done = res.system
-    system = RodSystem(scene.model, done.state.copy(), done.bcs)
-    system.add_term(scene.contact)
-    system.history = []
-    system.set_load(done.t)
+    system = system_at(scene, done, history=True)
     start = system.state.copy()
     # The sections start round at a tight knot's contacts: a longer way than a load
     # step's, hence a relaxation's budget.
@@ -271,15 +280,10 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
         # do not return: the sections settle again from the same start by proximal steps
         # alone, which only ever descend.
         system.state = start.copy()
-        again = yield from proximal(system, steps.proximal_dt, steps.proximal_steps,
-                                    steps.newton)
-        iters += again.newton_iterations
-        prox = f"{prox}; from the start again: {again.reason}"
-        if again.converged:
-            _, g, _ = yield Evaluate(system, system.free_vector(), True, False)
-            r = NewtonResult(True, r.iterations + again.newton_iterations,
-                             system.residual_norm(g), 0.0, system.last_split.total,
-                             "converged_by_proximal_steps", r.history)
+        r, again, reason = yield from descend(system, r, steps.proximal_dt,
+                                              steps.proximal_steps, steps.newton)
+        iters += again
+        prox = f"{prox}; from the start again: {reason}"
     why = ""
     if not r.converged:
         why = f"Newton {r.reason}" + (f", then proximal steps {prox}" if prox else

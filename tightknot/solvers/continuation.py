@@ -129,16 +129,25 @@ def static_solve(p: RodSystem, newton_options: NewtonOptions, proximal_dt: float
     if not res.converged and proximal_dt is not None and res.reason != "passed_through":
         # The static path may have a limit point here: descend through it by proximal
         # (fully damped implicit) steps from the last iterate at this load.
-        prox = yield from proximal(p, proximal_dt, proximal_steps,
-                                   proximal_newton or newton_options)
-        iterations += prox.newton_iterations
-        prox_reason = prox.reason
-        if prox.converged:
-            _, g, _ = yield Evaluate(p, p.free_vector(), True, False)
-            res = NewtonResult(True, res.iterations + prox.newton_iterations,
-                               p.residual_norm(g), 0.0, p.last_split.total,
-                               "converged_by_proximal_steps", res.history)
+        res, prox_iterations, prox_reason = yield from descend(
+            p, res, proximal_dt, proximal_steps, proximal_newton or newton_options)
+        iterations += prox_iterations
     return res, iterations, prox_reason
+
+
+def descend(p: RodSystem, res: NewtonResult, dt: float, steps: int,
+            options: NewtonOptions) -> Coroutine[tuple[NewtonResult, int, str]]:
+    """Proximal steps from the state of ``p`` after the failed Newton solve ``res``
+    (:func:`~tightknot.solvers.dynamic.proximal`): ``res`` itself where they fail, else
+    its ``"converged_by_proximal_steps"`` result with the residual there; and the Newton
+    iterations of the steps and why they stopped."""
+    prox = yield from proximal(p, dt, steps, options)
+    if prox.converged:
+        _, g, _ = yield Evaluate(p, p.free_vector(), True, False)
+        res = NewtonResult(True, res.iterations + prox.newton_iterations,
+                           p.residual_norm(g), 0.0, p.last_split.total,
+                           "converged_by_proximal_steps", res.history)
+    return res, prox.newton_iterations, prox.reason
 
 
 @program

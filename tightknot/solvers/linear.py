@@ -7,6 +7,8 @@ so a GPU path can plug in Warp's sparse CG behind the same call.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -139,16 +141,33 @@ class SparseDirect:
     @staticmethod
     def shifted_direction(h: sp.csc_matrix | LowRankHessian, g: np.ndarray, mu: float,
                           diag: np.ndarray) -> np.ndarray | None:
-        """Solve (H + mu D) d = -g with D = diag(``diag``); None when singular or not
-        finite. A low-rank update is solved by :func:`woodbury_solve` around the
-        factorization of the sparse part."""
-        base = h.base if isinstance(h, LowRankHessian) else h
-        a = base if mu == 0.0 else (base + sp.diags(mu * diag, format="csc"))
-        try:
-            fac = factorize(a)
-        except RuntimeError:  # exactly singular
-            return None
-        if isinstance(h, LowRankHessian):
-            return woodbury_solve(fac.solve, h.u, h.c, -g)
-        d = fac.solve(-g)
-        return d if np.isfinite(d).all() else None
+        """Solve (H + mu D) d = -g with D = diag(``diag``) by SuperLU
+        (:func:`shifted_solve`)."""
+        return shifted_solve(h, g, mu, diag, _superlu_solver)
+
+
+#: factor(A): the solution operator b -> A^-1 b of a sparse matrix, None when singular.
+Factor = Callable[[sp.spmatrix], Callable[[np.ndarray], np.ndarray] | None]
+
+
+def _superlu_solver(a: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray] | None:
+    try:
+        return factorize(a).solve
+    except RuntimeError:  # exactly singular
+        return None
+
+
+def shifted_solve(h: sp.csc_matrix | LowRankHessian, g: np.ndarray, mu: float,
+                  diag: np.ndarray, factor: Factor) -> np.ndarray | None:
+    """Solve (H + mu D) d = -g with D = diag(``diag``), the sparse part factored by
+    ``factor``; None when singular or not finite. A low-rank update is solved by
+    :func:`woodbury_solve` around the factorization of the sparse part."""
+    base = h.base if isinstance(h, LowRankHessian) else h
+    a = base if mu == 0.0 else (base + sp.diags(mu * diag, format="csc"))
+    solve = factor(a)
+    if solve is None:
+        return None
+    if isinstance(h, LowRankHessian):
+        return woodbury_solve(solve, h.u, h.c, -g)
+    d = solve(-g)
+    return d if np.isfinite(d).all() else None

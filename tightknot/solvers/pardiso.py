@@ -15,8 +15,8 @@ and go (the symbolic factorization is then redone on that ordering).
 PARDISO runs on one thread here: its result then does not depend on the thread count
 (MKL's conditional numerical reproducibility), and the workers of a sweep or a test run
 each have a core. ``pypardiso`` (BSD) loads MKL's runtime (the ``mkl`` wheel, x86_64 only;
-both in the ``fem`` extra); without it the sectioned level solves with SuperLU as the
-others do (:class:`tightknot.solvers.linear.SparseDirect`).
+both in the ``pardiso`` and ``fem`` extras); without it the sectioned level solves with
+SuperLU as the others do (:class:`tightknot.solvers.linear.SparseDirect`).
 """
 
 from __future__ import annotations
@@ -26,12 +26,13 @@ import glob
 import os
 import sys
 import weakref
+from collections.abc import Callable
 from functools import cache
 
 import numpy as np
 import scipy.sparse as sp
 
-from tightknot.solvers.linear import LowRankHessian, SparseDirect, woodbury_solve
+from tightknot.solvers.linear import LowRankHessian, SparseDirect, shifted_solve
 
 #: Environment variable that picks the sectioned level's linear solver.
 ENV_VAR = "TIGHTKNOT_SECTION_SOLVER"
@@ -88,7 +89,7 @@ def section_solver(name: str | None = None) -> str:
         return "pardiso" if available() else "superlu"
     if name == "pardiso" and not available():
         raise ImportError("the sectioned level's solver 'pardiso' needs pypardiso and MKL "
-                          "(pip install 'tightknot[fem]' on x86_64)")
+                          "(pip install 'tightknot[pardiso]' on x86_64)")
     return name
 
 
@@ -118,42 +119,39 @@ class _Handle:
 
     def call(self, phase: int, a: sp.csr_matrix, perm: np.ndarray, b: np.ndarray,
              x: np.ndarray) -> int:
-        err = ctypes.c_int32(0)
-        i32 = ctypes.c_int32
+        """PARDISO ``phase`` on the upper triangle ``a``; its error code (0: none)."""
         # one thread for this call only (a thread-local setting, restored after it)
         previous = self.lib.MKL_Set_Num_Threads_Local(1)
         try:
-            self.lib.pardiso(
-                self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)),
-                ctypes.byref(i32(1)), ctypes.byref(i32(1)), ctypes.byref(i32(-2)),
-                ctypes.byref(i32(phase)), ctypes.byref(i32(a.shape[0])),
-                a.data.ctypes.data, a.indptr.ctypes.data_as(ctypes.POINTER(i32)),
-                a.indices.ctypes.data_as(ctypes.POINTER(i32)),
-                perm.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(1)),
-                self.iparm.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(0)),
-                b.ctypes.data, x.ctypes.data, ctypes.byref(err))
+            return _pardiso(self.lib, self.pt, self.iparm, phase, a, perm, b, x)
         finally:
             self.lib.MKL_Set_Num_Threads_Local(previous)
-        return int(err.value)
+
+
+def _pardiso(lib: ctypes.CDLL, pt: np.ndarray, iparm: np.ndarray, phase: int,
+             a: sp.csr_matrix, perm: np.ndarray, b: np.ndarray, x: np.ndarray) -> int:
+    """One call of MKL's ``pardiso`` (one matrix, type -2, one right-hand side, silent)."""
+    i32 = ctypes.c_int32
+    p32 = ctypes.POINTER(i32)
+    err = i32(0)
+    lib.pardiso(pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ctypes.byref(i32(1)),
+                ctypes.byref(i32(1)), ctypes.byref(i32(-2)), ctypes.byref(i32(phase)),
+                ctypes.byref(i32(a.shape[0])), a.data.ctypes.data,
+                a.indptr.ctypes.data_as(p32), a.indices.ctypes.data_as(p32),
+                perm.ctypes.data_as(p32), ctypes.byref(i32(1)), iparm.ctypes.data_as(p32),
+                ctypes.byref(i32(0)), b.ctypes.data, x.ctypes.data, ctypes.byref(err))
+    return int(err.value)
 
 
 def _release(lib: ctypes.CDLL, pt: np.ndarray) -> None:
     """PARDISO phase -1: free all its memory of the instance ``pt``."""
     if not pt.any():
         return
-    i32 = ctypes.c_int32
-    dummy = np.zeros(1, dtype=np.float64)
-    idx = np.zeros(2, dtype=np.int32)
-    iparm = np.zeros(64, dtype=np.int32)
-    err = ctypes.c_int32(0)
-    lib.pardiso(pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ctypes.byref(i32(1)),
-                ctypes.byref(i32(1)), ctypes.byref(i32(-2)), ctypes.byref(i32(-1)),
-                ctypes.byref(i32(1)), dummy.ctypes.data,
-                idx.ctypes.data_as(ctypes.POINTER(i32)),
-                idx.ctypes.data_as(ctypes.POINTER(i32)),
-                idx.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(1)),
-                iparm.ctypes.data_as(ctypes.POINTER(i32)), ctypes.byref(i32(0)),
-                dummy.ctypes.data, dummy.ctypes.data, ctypes.byref(err))
+    one = sp.csr_matrix(np.ones((1, 1)))
+    one.indptr, one.indices = one.indptr.astype(np.int32), one.indices.astype(np.int32)
+    dummy = np.zeros(1)
+    _pardiso(lib, pt, np.zeros(64, dtype=np.int32), -1, one, np.zeros(1, dtype=np.int32),
+             dummy, dummy.copy())
 
 
 class PardisoDirect(SparseDirect):
@@ -191,21 +189,12 @@ class PardisoDirect(SparseDirect):
 
     def shifted_direction(self, h: sp.csc_matrix | LowRankHessian, g: np.ndarray, mu: float,
                           diag: np.ndarray) -> np.ndarray | None:
-        """Solve (H + mu D) d = -g with D = diag(``diag``); None when the factorization
-        fails or the result is not finite. A low-rank update is solved by
-        :func:`~tightknot.solvers.linear.woodbury_solve` around the sparse part."""
-        base = h.base if isinstance(h, LowRankHessian) else h
-        a = sp.csc_matrix(base)
-        if mu != 0.0:
-            a = a + sp.diags(mu * diag, format="csc")
-        solve = self._factorize(a)
-        if solve is None:
-            return None
-        d = (woodbury_solve(solve, h.u, h.c, -g) if isinstance(h, LowRankHessian)
-             else solve(-g))
-        return d if d is not None and np.isfinite(d).all() else None
+        """Solve (H + mu D) d = -g with D = diag(``diag``) by PARDISO
+        (:func:`~tightknot.solvers.linear.shifted_solve`)."""
+        return shifted_solve(h, g, mu, diag, self._factorize)
 
-    def _factorize(self, a: sp.csc_matrix):
+    def _factorize(self, a: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray] | None:
+        a = sp.csc_matrix(a)
         a.sum_duplicates()
         d = np.abs(a.diagonal())
         s = 1.0 / np.sqrt(np.where(d > 0.0, d, 1.0))
