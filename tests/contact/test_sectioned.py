@@ -469,3 +469,27 @@ def _boundary_at(layer: SectionedLayer, state: State, v: int, point: np.ndarray)
     d2 = np.cross(t, d1)
     phi = math.atan2(point @ d2, point @ d1)
     return _boundary(layer, state, v, np.array([phi]))[0]
+
+
+def test_the_penalty_scale_scales_the_contact_and_nothing_else() -> None:
+    # section_finish's homotopy grows the penalty: the contact energy, its gradient and
+    # its Hessian are linear in the penalty (the rounded onset is a length), so at a
+    # quarter of it they are a quarter, to round-off; the energy-only evaluation's pairs
+    # are not reused across a change; the scale is refused outside (0, 1].
+    system, layer, rng = _crossing_rods(0.97, 1.0, SectionSettings(max_mode=6, samples=32))
+    x, rest, frames = system.state.x, system.rest, system.state.frames
+    extra = 0.002 * D0 * rng.normal(size=layer.dof_count)
+    full = layer.contact_energy(x, extra, frames, rest, True, True)
+    layer.contact_energy(x, extra, frames, rest, False, False)
+    layer.set_penalty_scale(0.25)
+    quarter = layer.contact_energy(x, extra, frames, rest, True, True)
+    assert full[0] > 0.0 and quarter[0] == pytest.approx(0.25 * full[0], rel=1e-12)
+    for a, b in ((full[1], quarter[1]), (full[2], quarter[2]),
+                 (full[3].blocks, quarter[3].blocks)):
+        assert np.allclose(b, 0.25 * a, rtol=1e-12, atol=1e-12 * np.abs(a).max())
+    layer.set_penalty_scale(1.0)
+    again = layer.contact_energy(x, extra, frames, rest, True, True)
+    assert again[0] == full[0]
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="penalty scale"):
+            layer.set_penalty_scale(bad)

@@ -187,21 +187,29 @@ def test_sections_thinner_than_the_fem_judged_are_said(sectioned_run) -> None:
     assert any("A/A0 = 0.43, below the 0.693" in w for w in out["warnings"])
 
 
-def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch) -> None:
-    """Where Newton and the proximal steps after it fail from the round sections (they can
-    end in a far basin: docs/sectioned_level.md), section_finish descends again from its
-    start by proximal steps alone, to the equilibrium the direct solve finds."""
+@pytest.mark.parametrize("homotopy_fails", [False, True])
+def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch,
+                                                             homotopy_fails: bool) -> None:
+    """Where Newton fails from the round sections (it can leap into a far basin:
+    docs/sectioned_level.md), section_finish solves again from its start with the penalty
+    grown from an eighth by doubling; where that fails too, it descends from its start by
+    proximal steps alone. Either way it reaches the equilibrium the direct solve finds, and
+    the layer keeps its own penalty."""
     import tightknot.loading.tie as tie_module
 
     ref = tie(closed_trefoil(16.37, nodes=40, contact="sectioned"), tighten_steps=20,
               section_path="final").run()
     assert ref.converged, ref.failure
     real = tie_module.static_solve
-    failed = []
+    scene = closed_trefoil(16.37, nodes=40, contact="sectioned")
+    seen: list[float] = []
 
-    def lost_once(system, newton_options, *args, **kwargs):
-        if newton_options.max_iterations == 400 and not failed:  # the sections' own solve
-            failed.append(True)
+    def lost(system, newton_options, *args, **kwargs):
+        scale = scene.contact.penalty_scale
+        seen.append(scale)
+        direct = (newton_options.max_iterations == tie_module.DIRECT_SECTION_ITERATIONS
+                  and len(seen) == 1)
+        if direct or (homotopy_fails and scale < 1.0 and len(seen) == 2):
             # an end far from the start, as a leap into another basin leaves it
             system.state.x = system.state.x * 1.01
             r, iterations, _ = yield from real(system, dataclasses.replace(
@@ -209,11 +217,15 @@ def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch) -> Non
             return dataclasses.replace(r, converged=False, reason="max_iterations"), 1, "lost"
         return (yield from real(system, newton_options, *args, **kwargs))
 
-    monkeypatch.setattr(tie_module, "static_solve", lost_once)
-    res = tie(closed_trefoil(16.37, nodes=40, contact="sectioned"), tighten_steps=20,
-              section_path="final").run()
-    assert failed and res.converged, res.failure
+    monkeypatch.setattr(tie_module, "static_solve", lost)
+    res = tie(scene, tighten_steps=20, section_path="final").run()
+    assert res.converged, res.failure
     assert res.knot_types[-1] == "3_1"
+    # the direct solve at the full penalty, then the homotopy's (only its first where it
+    # is made to fail; the proximal steps then run at the full penalty)
+    assert seen[0] == 1.0
+    assert seen[1:] == ([0.125] if homotopy_fails else list(tie_module.PENALTY_HOMOTOPY))
+    assert scene.contact.penalty_scale == 1.0
     # the same knot: a closed knot's equilibria along its slide differ by ~1e-4 D0 in
     # stretch (this file's final-versus-full test); its length to 1e-4
     x, x_ref = res.system.state.x, ref.system.state.x

@@ -96,6 +96,9 @@ def _chunk_pool() -> ThreadPoolExecutor:
                                    thread_name_prefix="tightknot-pass")
     return _POOL
 
+#: Index of the penalty among a pass kernel's model arguments (``SectionedLayer._model_args``).
+_PENALTY_ARG = 16
+
 _CALIBRATION_FILE = Path(__file__).resolve().parents[1] / "data" / "section_calibration.json"
 
 
@@ -349,6 +352,9 @@ class SectionedLayer(ContactLayer):
             sample_cos, sample_sin, k, samples, float(self.penalty), float(self.section.onset),
             rod_mean,
         ]
+        assert self._model_args[_PENALTY_ARG] == float(self.penalty)
+        #: The factor on the penalty of the contact kernels (:meth:`set_penalty_scale`).
+        self.penalty_scale = 1.0
         # the inputs of sk.section_bounds before the state's, and its outputs
         self._bounds_args = [self.broad_phase.edge_vertex, vertex_offset, edge_r0, edge_nu,
                              edge_rigid, k, rod_mean]
@@ -370,6 +376,16 @@ class SectionedLayer(ContactLayer):
         # the state (x, extra, rest, frames) of the last energy-only evaluation and its
         # pairs in contact (:meth:`contact_energy`)
         self._energy_only: tuple | None = None
+
+    def set_penalty_scale(self, scale: float) -> None:
+        """Scale the contact penalty by ``scale`` in (0, 1] (1: the calibrated level): a
+        homotopy that lets round sections settle into a tight knot's contacts gradually
+        (:func:`tightknot.loading.tie.section_finish`)."""
+        if not (math.isfinite(scale) and 0.0 < scale <= 1.0):
+            raise ValueError(f"penalty scale must be in (0, 1], got {scale!r}")
+        self._model_args[_PENALTY_ARG] = float(self.penalty) * float(scale)
+        self.penalty_scale = float(scale)
+        self._energy_only = None
 
     # -- the section field -----------------------------------------------------------------
     def end_twist(self, m_ref: np.ndarray) -> np.ndarray:

@@ -49,7 +49,7 @@ from tightknot.solvers.continuation import (
     descend,
     static_solve,
 )
-from tightknot.solvers.newton import NewtonOptions, newton
+from tightknot.solvers.newton import NewtonOptions, NewtonResult, newton
 from tightknot.solvers.program import Coroutine, Program
 from tightknot.solvers.system import RodSystem
 
@@ -253,14 +253,44 @@ def system_at(scene: KnotScene, done: RodSystem, history: bool = False) -> RodSy
     return system
 
 
+#: Newton iterations of :func:`section_finish`'s first solve at the full penalty.
+DIRECT_SECTION_ITERATIONS = 150
+#: The penalty factors of :func:`section_finish`'s homotopy, the last the level's own.
+PENALTY_HOMOTOPY = (0.125, 0.25, 0.5, 1.0)
+
+
+def _penalty_homotopy(system: RodSystem, layer: SectionedLayer, steps: ContinuationOptions
+                      ) -> Coroutine[tuple[NewtonResult, int, str]]:
+    """Static solves of ``system`` at the penalty factors :data:`PENALTY_HOMOTOPY` of
+    ``layer`` in turn, each from the last one's equilibrium (Newton, then proximal steps);
+    the last solve's result (the first failed one's where one fails), the iterations of
+    all and how it ended. The layer's own penalty is restored."""
+    iters = 0
+    try:
+        for f in PENALTY_HOMOTOPY:
+            layer.set_penalty_scale(f)
+            r, it, prox = yield from static_solve(
+                system, dataclasses.replace(steps.newton, max_iterations=400),
+                steps.proximal_dt, steps.proximal_steps, steps.newton)
+            iters += it
+            if not r.converged:
+                return r, iters, (f"at {f:g} of the penalty, Newton {r.reason}"
+                                  + (f", proximal steps {prox}" if prox else ""))
+    finally:
+        layer.set_penalty_scale(1.0)
+    return r, iters, "converged"
+
+
 def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
                    hook: StepHook | None = None,
                    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
                    end_held: bool = False) -> Coroutine[TieResult]:
     """The equilibrium of ``scene`` at its own contact level under the last load of
     ``res``, a converged load path of the same rod at another level (:func:`path_scene`):
-    one static solve from its equilibrium, round sections added (proximal steps where
-    Newton fails), the knot type checked, ``hook("section", ...)`` called with it. With
+    one static solve from its equilibrium, round sections added (where Newton fails
+    within :data:`DIRECT_SECTION_ITERATIONS`, the same start again with the penalty grown
+    by :func:`_penalty_homotopy`, then proximal steps alone), the knot type checked,
+    ``hook("section", ...)`` called with it. With
     ``end_held`` the pulling force is the held end's reaction at the new equilibrium.
     On failure the result's state is the load path's equilibrium (round sections), the
     failed solve's end in ``failed_state``."""
@@ -268,26 +298,35 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     done = res.system
     system = system_at(scene, done, history=True)
     start = system.state.copy()
-    # The sections start round at a tight knot's contacts: a longer way than a load
-    # step's, hence a relaxation's budget.
     steps = load_step_options(1, residual_tol)
-    r, iters, prox = yield from static_solve(
-        system, dataclasses.replace(steps.newton, max_iterations=400), steps.proximal_dt,
-        steps.proximal_steps, steps.newton)
-    if not r.converged and system.violation is None and r.reason != "passed_through":
-        # Newton from the round sections can leap into a far basin (single edges necking
-        # under their sections' thinning, docs/sectioned_level.md) from which proximal steps
-        # do not return: the sections settle again from the same start by proximal steps
-        # alone, which only ever descend.
+    # A first Newton solve at the full penalty, on a budget of twice the most iterations
+    # it took where it converged (27 to 75 on the study's knots, docs/sectioned_level.md).
+    r, iters, _ = yield from static_solve(
+        system, dataclasses.replace(steps.newton, max_iterations=DIRECT_SECTION_ITERATIONS),
+        None, 0)
+    retry = not r.converged and system.violation is None and r.reason != "passed_through"
+    tried = [f"Newton {r.reason}"]
+    layer = scene.contact
+    if retry and isinstance(layer, SectionedLayer):
+        # From round sections at a tight knot's contacts, Newton can leap into a far basin
+        # (single edges necking under their sections' thinning, docs/sectioned_level.md).
+        # The penalty is then grown from an eighth of its value by doubling, each solve
+        # starting from the equilibrium of the softer one.
+        system.state = start.copy()
+        r, again, stopped = yield from _penalty_homotopy(system, layer, steps)
+        iters += again
+        tried.append(f"the penalty grown from the start: {stopped}")
+        retry = not r.converged and system.violation is None and r.reason != "passed_through"
+    if retry:
+        # Proximal steps alone from the same start only ever descend.
         system.state = start.copy()
         r, again, reason = yield from descend(system, r, steps.proximal_dt,
                                               steps.proximal_steps, steps.newton)
         iters += again
-        prox = f"{prox}; from the start again: {reason}"
+        tried.append(f"proximal steps from the start: {reason}")
     why = ""
     if not r.converged:
-        why = f"Newton {r.reason}" + (f", then proximal steps {prox}" if prox else
-                                      f": {system.violation}" if system.violation else "")
+        why = "; ".join(tried) + (f": {system.violation}" if system.violation else "")
     types = list(res.knot_types)
     rec = StepRecord(done.t, r)
     if not why:
