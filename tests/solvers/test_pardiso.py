@@ -30,11 +30,13 @@ def _blocks(n_nodes: int, block: int, pairs: list[tuple[int, int]], seed: int = 
     a = a + a.T
     # diagonal dominance makes it definite; one negative block makes it indefinite
     d = np.abs(a).sum(axis=1).A.ravel() + 1.0
-    # decades apart, as positions and section amplitudes are
-    d *= 10.0 ** rng.integers(-3, 4, n_nodes).repeat(block)
     if indefinite:
         d[:block] *= -1.0
-    return sp.csc_matrix(a + sp.diags(d))
+    a = a + sp.diags(d)
+    # scaled symmetrically by decades, as positions and section amplitudes are (S A S
+    # keeps the inertia)
+    s = sp.diags(10.0 ** (0.5 * rng.integers(-3, 4, n_nodes).repeat(block)))
+    return sp.csc_matrix(s @ a @ s)
 
 
 @needs_mkl
@@ -44,11 +46,33 @@ def test_the_direction_is_superlus(indefinite: bool, mu: float) -> None:
     a = _blocks(30, 6, [(2, 20), (5, 17), (9, 25)], indefinite=indefinite)
     g = np.random.default_rng(1).standard_normal(a.shape[0])
     diag = np.abs(a.diagonal())
-    d = pardiso.PardisoDirect().shifted_direction(a, g, mu, diag)
+    d = pardiso.PardisoDirect(convex=False).shifted_direction(a, g, mu, diag)
     ref = SparseDirect.shifted_direction(a, g, mu, diag)
     # both direct: round-off of a well-conditioned system (condition ~1e6 from the
     # decades of scale, removed by the equilibration)
     assert np.linalg.norm(d - ref) <= 1e-10 * np.linalg.norm(ref)
+
+
+@needs_mkl
+def test_a_matrix_with_a_negative_eigenvalue_is_refused_until_shifted() -> None:
+    # PARDISO's inertia: a convex solver refuses H + mu D while it has a negative
+    # eigenvalue, so that the Newton loop raises mu (here the first block's diagonal is
+    # negative: a shift of twice its size makes the matrix definite again)
+    a = _blocks(30, 6, [(2, 20), (5, 17)], indefinite=True)
+    g = np.random.default_rng(1).standard_normal(a.shape[0])
+    diag = np.abs(a.diagonal())
+    solver = pardiso.PardisoDirect()
+    assert np.linalg.eigvalsh(a.toarray()).min() < 0.0
+    assert solver.shifted_direction(a, g, 0.0, diag) is None
+    assert solver.indefinite == 1
+    shifted = a + sp.diags(3.0 * diag)
+    assert np.linalg.eigvalsh(shifted.toarray()).min() > 0.0
+    d = solver.shifted_direction(a, g, 3.0, diag)
+    assert d is not None
+    assert np.linalg.norm(shifted @ d + g) <= 1e-10 * np.linalg.norm(g)
+    assert solver.indefinite == 1
+    # without the test (a low-rank update's solver) the indefinite direction is returned
+    assert pardiso.PardisoDirect(convex=False).shifted_direction(a, g, 0.0, diag) is not None
 
 
 @needs_mkl

