@@ -1,4 +1,5 @@
-"""The Newton loop's contract: it reports failure instead of returning NaN."""
+"""The Newton loop's contract: it reports failure instead of returning NaN; its shift's
+ladder after an inertia refusal."""
 
 import math
 
@@ -9,9 +10,10 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material, second_moment
 from tightknot.rods.state import State
+from tightknot.solvers import pardiso
 from tightknot.solvers.continuation import ContinuationOptions, continuation
 from tightknot.solvers.linear import factorize
-from tightknot.solvers.newton import NewtonOptions, newton
+from tightknot.solvers.newton import NewtonOptions, _raised, newton
 from tightknot.solvers.pattern import SparsePattern
 from tightknot.solvers.system import RodSystem
 
@@ -122,3 +124,55 @@ def test_a_batch_rod_is_not_evaluated_alone() -> None:
     system.batch = object()  # attached to some batch: only the batch answers it
     with pytest.raises(RuntimeError, match="answered by the batch"):
         system.evaluate(system.free_vector())
+
+
+def _column(load_parameter: float) -> RodSystem:
+    """A clamped column pushed along its axis by ``load_parameter`` EI/L^2 (Euler's
+    critical load of a cantilever is pi^2/4 = 2.47 of them), bent slightly to start."""
+    n = 30
+    x = np.linspace(0.0, 1.0, n)
+    b = RodBuilder()
+    b.add_rod(np.c_[x, 1e-3 * x**2, 0 * x], diameter=0.01,
+              material=Material(1e6, 0.5, 1000.0))
+    m = b.finalize()
+    f = load_parameter * 1e6 * second_moment(0.01)
+    system = RodSystem(m, State.initial(m),
+                       BoundaryConditions(m).clamp(0, "start").force(0, -1, [-f, 0, 0]))
+    system.set_load(1.0)
+    return system
+
+
+def test_the_inertia_ladder_skips_rungs_only() -> None:
+    # After a refusal for a negative eigenvalue the shift's ladder starts at shift_inertia
+    # but passes through the same values as the plain ladder from shift_initial.
+    opt = NewtonOptions(shift_initial=1e-8, shift_inertia=1e-6)
+    plain = [0.0]
+    for _ in range(6):
+        plain.append(_raised(plain[-1], opt, False))
+    assert plain[1] == 1e-8
+    assert _raised(0.0, opt, True) == plain[3]
+    assert _raised(plain[1], opt, True) == plain[3]
+    assert _raised(plain[4], opt, True) == plain[5]
+
+
+@pytest.mark.skipif(not pardiso.available(), reason="pypardiso and MKL not installed")
+def test_an_inertia_refusal_costs_fewer_factorizations_on_the_same_path() -> None:
+    runs = []
+    for inertia in (1e-8, 1e-6):  # 1e-8 = shift_initial: the plain ladder
+        system = _column(5.0)
+        system.linear = pardiso.PardisoDirect()
+        opts = NewtonOptions(shift_inertia=inertia, max_iterations=200)
+        res = newton(system, system.free_vector(), opts).run()
+        runs.append((res, system.linear, system.state.x.copy()))
+    (plain, lin_plain, x_plain), (skip, lin_skip, x_skip) = runs
+    assert plain.converged and skip.converged
+    # the column buckles: its first Hessians have a negative eigenvalue
+    assert lin_plain.indefinite > 0
+    assert np.ptp(x_plain[:, 1]) > 0.1
+    # the same shifts accepted, so the same iterates bit for bit
+    assert plain.history == skip.history
+    np.testing.assert_array_equal(x_plain, x_skip)
+    # two rungs (1e-8, 1e-7) fewer for every climb from zero that passed them
+    assert lin_skip.factorizations < lin_plain.factorizations
+    assert lin_plain.indefinite - lin_skip.indefinite == \
+        lin_plain.factorizations - lin_skip.factorizations

@@ -122,6 +122,9 @@ class SparseDirect:
 
     #: The solver's name in run summaries.
     name = "superlu"
+    #: Whether the last :meth:`shifted_direction` returned None because the shifted matrix
+    #: has a negative eigenvalue (a solver that reads the factorization's inertia).
+    refused_indefinite = False
 
     @staticmethod
     def matrix(h: sp.csc_matrix | LowRankHessian) -> object:

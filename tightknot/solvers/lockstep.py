@@ -60,6 +60,8 @@ class BandedSolver:
 
     #: The solver's name in run summaries.
     name = "banded"
+    #: It reads no inertia (:attr:`tightknot.solvers.linear.SparseDirect.refused_indefinite`).
+    refused_indefinite = False
 
     #: Largest n bw^2 (dofs times half-bandwidth squared) solved in band storage: banded
     #: LU costs about 4 n bw^2 flops; a band of a few distant contacts of a loose knot

@@ -48,6 +48,12 @@ class NewtonOptions:
         max_backtracks: line-search halvings before the shift is raised instead.
         shift_initial: first relative shift mu when the Hessian is not positive definite.
         shift_trust: first relative shift when steps overshoot (trust-region damping).
+        shift_inertia: the smallest shift tried after the linear solver refused the shifted
+            Hessian for a negative eigenvalue (a solver that reads its factorization's
+            inertia, :class:`tightknot.solvers.pardiso.PardisoDirect`): the shift's
+            ladder (``shift_initial`` times powers of ten) skips the rungs below it,
+            factorizations too small a shift to lift the negative eigenvalues of a
+            tight knot's sectioned Hessian (docs/sectioned_level.md, "Cost").
         shift_max: beyond this shift the solve gives up.
         stall_iterations: window of the no-progress test (0 turns it off): the solve stops
             as "stalled" when over this many iterations the best residual did not fall
@@ -70,6 +76,7 @@ class NewtonOptions:
     max_backtracks: int = 30
     shift_initial: float = 1e-8
     shift_trust: float = 1e-3
+    shift_inertia: float = 1e-6
     shift_max: float = 1e8
     stall_iterations: int = 50
     stall_factor: float = 0.5
@@ -78,7 +85,7 @@ class NewtonOptions:
 
     def __post_init__(self) -> None:
         for name in ("residual_tol", "step_tol", "armijo", "shift_initial", "shift_trust",
-                     "shift_max", "stall_factor", "stall_roundoffs"):
+                     "shift_inertia", "shift_max", "stall_factor", "stall_roundoffs"):
             v = getattr(self, name)
             if not (isinstance(v, numbers.Real) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be finite and > 0, got {v!r}")
@@ -152,7 +159,7 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
             # H d is kept for the model decrease after the line search.
             hd = None if d is None else h @ d
             if d is None or not _acceptable(d, g, hd, mu, diag):
-                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
+                mu = _raised(mu, opt, d is None and p.linear.refused_indefinite)
                 if mu > opt.shift_max:
                     yield from accept(p, u)
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
@@ -239,6 +246,17 @@ def _stalled(best: list[float], energies: list[float], opt: NewtonOptions,
     if best[-1] < opt.stall_factor * best[-1 - w]:
         return False
     return energies[-1 - w] - energies[-1] <= opt.stall_roundoffs * roundoff
+
+
+def _raised(mu: float, opt: NewtonOptions, indefinite: bool) -> float:
+    """The shift's next rung after ``mu`` failed: ``shift_initial``, then ten times the
+    last; after a refusal for a negative eigenvalue (``indefinite``) the first rung at or
+    above ``shift_inertia`` (the same values the ladder passes through, without the
+    factorizations below)."""
+    mu = opt.shift_initial if mu == 0.0 else mu * 10.0
+    while indefinite and mu < opt.shift_inertia:
+        mu *= 10.0
+    return mu
 
 
 def _acceptable(d: np.ndarray, g: np.ndarray, hd: np.ndarray, mu: float,

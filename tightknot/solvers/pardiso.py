@@ -207,6 +207,7 @@ class PardisoDirect(SparseDirect):
         positive definite, so that the Newton loop raises mu. A low-rank update's inertia
         is not the factored part's: there only the Newton loop's own test judges."""
         convex = self._convex and not isinstance(h, LowRankHessian)
+        self.refused_indefinite = False
         return shifted_solve(h, g, mu, diag,
                              lambda b, m, dg: self._factorize(b, m, dg, convex))
 
@@ -288,6 +289,7 @@ class PardisoDirect(SparseDirect):
             # convex, so Newton raises the shift (inertia correction, Waechter & Biegler,
             # Math. Program. 106 (2006) 25, sec. 3.1)
             self.indefinite += 1
+            self.refused_indefinite = True
             return None
 
         def solve(b: np.ndarray) -> np.ndarray:
