@@ -176,3 +176,39 @@ def test_an_inertia_refusal_costs_fewer_factorizations_on_the_same_path() -> Non
     assert lin_skip.factorizations < lin_plain.factorizations
     assert lin_plain.indefinite - lin_skip.indefinite == \
         lin_plain.factorizations - lin_skip.factorizations
+
+
+class _Rejudged(RodSystem):
+    """A rod system whose energy rises by ``jump`` [J] each time a state is accepted, as
+    the sectioned level's does where accepting a step carries its frames (and the reference
+    twist its sections turn with) on: the function changes, its derivatives do not."""
+
+    jump = 0.0
+    accepted_states = 0
+
+    def evaluate(self, u, want_grad=True, want_hess=True):  # noqa: ANN001, ANN201
+        e, *rest = super().evaluate(u, want_grad, want_hess)
+        return (e + self.jump * self.accepted_states, *rest)
+
+    def accept(self, u: np.ndarray) -> None:
+        super().accept(u)
+        self.accepted_states += 1
+
+
+def test_a_change_of_energy_on_acceptance_does_not_steer_the_trust_shift() -> None:
+    # The trust ratio compares the model's decrease with the line search's, both at the
+    # frames the model was made with; a change of the energy on acceptance is no evidence
+    # against the model. With it judged as one, the shift rose and the solve took damped
+    # steps (a sectioned pull step stalled at a residual of 2e-3 for 40 iterations).
+    runs = []
+    for jump in (0.0, 1e-9):
+        base = _cantilever(load_parameter=3.0)
+        system = _Rejudged(base.model, base.state, base.bcs)
+        system.jump = jump
+        system.set_load(1.0)
+        res = newton(system, system.free_vector(), NewtonOptions(max_iterations=100)).run()
+        runs.append((res, system.state.x.copy()))
+    (plain, x_plain), (jumping, x_jumping) = runs
+    assert plain.converged and jumping.converged
+    assert plain.history == jumping.history
+    np.testing.assert_array_equal(x_plain, x_jumping)

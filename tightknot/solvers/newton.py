@@ -212,8 +212,12 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
         # more; a full step that the model predicted well lets the shift decay to zero.
         # Below the energy's round-off the actual decrease is noise: the ratio then says
         # nothing about the model, and must not raise the shift (it did, without end).
+        # The actual decrease is the line search's (e_trial), evaluated with the frames the
+        # model was made with: accepting the step carries the frames on, which can change
+        # the energy of a level whose sections turn with them (the reference twist, held
+        # within an iteration), and that change says nothing about the model either.
         unjudged = predicted <= roundoff
-        ratio = (e_old - energy) / predicted if predicted > 0 and not unjudged else 1.0
+        ratio = (e_old - e_trial) / predicted if predicted > 0 and not unjudged else 1.0
         if alpha < 0.5 or ratio < 0.25:
             mu = max(4.0 * mu, opt.shift_trust)
         elif alpha == 1.0 and ratio > 0.75:
