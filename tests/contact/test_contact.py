@@ -201,6 +201,44 @@ def test_step_bound_prevents_passing_through() -> None:
     assert cl.max_step(x, -dx, m.edge_rest_length) == 1.0
 
 
+def test_a_step_that_moves_two_pieces_alike_is_not_cut() -> None:
+    # The bound counts the two edges' relative motion: the crossing carried 3 D along and
+    # 2 D down as a whole keeps every distance, so nothing cuts it; rod 1 pushed 3 D down
+    # through rod 0 while both are carried 3 D along is cut where the push alone is, to
+    # (1.2 - 0.1) / 3 (a bound on the sum of the two edges' motions cut these to
+    # 1.1 / (2 sqrt(13)) = 0.15 and 1.1 / (3 + 3 sqrt(2)) = 0.15).
+    m = two_rods(90.0, 1.2 * D, n=21, length=6 * D)
+    cl = ContactLayer(m, LAW, hard_fraction=0.1)
+    x = m.vertex_initial_position
+    carried = np.tile([3.0 * D, 0.0, -2.0 * D], (x.shape[0], 1))
+    assert cl.max_step(x, carried, m.edge_rest_length) == 1.0
+    push = np.tile([3.0 * D, 0.0, 0.0], (x.shape[0], 1))
+    push[m.rods[1].vertex_slice, 2] = -3.0 * D
+    assert cl.max_step(x, push, m.edge_rest_length) == pytest.approx(1.1 / 3, rel=1e-9)
+
+
+def test_random_steps_within_the_bound_never_pass_through() -> None:
+    # Random steps of a tangle of two crossing rods (each vertex moved by up to 2 D, with
+    # a shared part): along every step cut to its bound the two rods stay at least the
+    # hard limit apart (checked at 201 points of the way, the independent proximity check).
+    from tightknot.rods.proximity import ProximityCheck
+
+    m = two_rods(60.0, 1.1 * D, n=21, length=6 * D)
+    cl = ContactLayer(m, LAW, hard_fraction=0.1)
+    check = ProximityCheck(m, hard_fraction=0.1 * (1 - 1e-9), local_fraction=0.25)
+    rest = m.edge_rest_length
+    x = m.vertex_initial_position
+    rng = np.random.default_rng(7)
+    cut = 0
+    for _ in range(20):
+        dx = 2.0 * D * (rng.uniform(-1, 1, x.shape) + rng.uniform(-1, 1, 3))
+        alpha = cl.max_step(x, dx, rest)
+        cut += alpha < 1.0
+        for u in np.linspace(0.0, alpha, 201):
+            assert not check.check(x + u * dx, rest).violated
+    assert cut >= 10  # the steps do reach the bound
+
+
 def test_a_step_too_long_for_the_broad_phase_is_cut_and_stays_safe(monkeypatch) -> None:
     # Rod 1 crosses a long rod 0 1.2 D above it; a step moves it 300 D along rod 0 and 300 D
     # down, sweeping its bounds over all of rod 0. With the broad phase's limit lowered

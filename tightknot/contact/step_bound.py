@@ -1,10 +1,15 @@
 """No passing through: the largest fraction of a step that keeps every pair of segments
 sharing no vertex at least its floor apart along the straight path.
 
-Segment distance is 1-Lipschitz in the motion of its points, and each point of an edge moves
-at most max(|dx| of its two vertices) along the straight step; so no point pair comes closer
-than d0 - alpha (m_a + m_b), and alpha = (d0 - floor)/(m_a + m_b) keeps the pair at least
-``floor`` apart along the whole step: no passing through by construction. Every pair counts,
+Along the straight step, the points a(s) of one edge and b(t) of the other move by alpha
+da(s) and alpha db(t), so |a(s) - b(t)| falls by at most alpha |da(s) - db(t)|; da(s) -
+db(t) is affine in (s, t), so its norm is convex and largest at a corner of the unit
+square: M = max |da_i - db_j| over the four vertex pairs. No point pair then comes closer
+than d0 - alpha M, and alpha = (d0 - floor) / M keeps the pair at least ``floor`` apart
+along the whole step: no passing through by construction. The relative motion counts, not
+the sum of the two edges' largest motions (M <= m_a + m_b): material sliding along a rod
+through a knot moves the near pairs of that rod alike, and a bound on the sum cut such
+steps (docs/design_notes.md, "The step bound"). Every pair counts,
 neighbours along the rod too (the energy may not watch them: the exclusion window). The
 floor of a pair is the hard limit (``hard_fraction`` D), or, for two edges of one rod whose
 nearest ends are an arc s apart, ``local_fraction`` D sin(min(s/D, pi/2)) where smaller: a
@@ -123,7 +128,8 @@ def step_bound_kernel(
     alpha_out: wp.array(dtype=wp.float64),
     distance_out: wp.array(dtype=wp.float64),
 ):
-    # Each pair's largest step fraction (module docstring) and its segment distance.
+    # Each pair's largest step fraction (module docstring: the largest relative motion of
+    # two vertices, one of each edge) and its segment distance.
     p = wp.tid()
     pr = pairs_in[p]
     va = edge_vertex[pr[0]]
@@ -131,11 +137,14 @@ def step_bound_kernel(
     res = segment_distance(x_in[va[0]], x_in[va[1]], x_in[vb[0]], x_in[vb[1]])
     d0 = res[0]
     distance_out[p] = d0
-    ma = wp.max(wp.length(dx_in[va[0]]), wp.length(dx_in[va[1]]))
-    mb = wp.max(wp.length(dx_in[vb[0]]), wp.length(dx_in[vb[1]]))
+    a0 = dx_in[va[0]]
+    a1 = dx_in[va[1]]
+    b0 = dx_in[vb[0]]
+    b1 = dx_in[vb[1]]
     hard = pair_floor(pr[0], pr[1], edge_rod, rod_closed, edge_hard, edge_diameter,
                       local_fraction, edge_arc_in, rod_length_in)
-    move = ma + mb
+    move = wp.max(wp.max(wp.length(a0 - b0), wp.length(a0 - b1)),
+                  wp.max(wp.length(a1 - b0), wp.length(a1 - b1)))
     alpha = f64(1.0e30)
     if move > f64(0.0):
         alpha = (d0 - hard) / move
