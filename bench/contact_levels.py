@@ -3,7 +3,7 @@
 ratios, not seconds: the machines are shared).
 
 Usage: ``python bench/contact_levels.py [--closed-nodes 100] [--open-nodes 150]
-[--levels compliant smoothed] [--section-path auto] [--json out.json]``. The level
+[--levels compliant smoothed] [--section-path auto] [--repeat 1] [--json out.json]``. The level
 ``sectioned-shift`` is the sectioned level with its bend shift
 (``SectionSettings(bend_shift=True)``, docs/sectioned_level.md); ``sectioned-rod`` the
 sectioned level with its sections thinned by the rod's mean stretch
@@ -86,6 +86,13 @@ def _edge_stretch(x: np.ndarray, rest: np.ndarray) -> dict:
             "edge_stretch_max_over_median": float(lam.max() / np.median(lam))}
 
 
+def _warm_up(levels: list[str]) -> None:
+    """Compile (or load) every level's kernels and load its linear solver's library outside
+    the timing: a 40-vertex closed trefoil tied at each level."""
+    for level in dict.fromkeys(levels):
+        tie(closed_trefoil(nodes=40, contact=_contact(level)), tighten_steps=5).run()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--closed-nodes", type=int, default=100)
@@ -95,23 +102,45 @@ def main() -> None:
                                  "sectioned-rod", "rigid"])
     parser.add_argument("--section-path", default="auto", choices=list(SECTION_PATHS),
                         help="the sectioned level's load path (tightknot.loading.tie.path_scene)")
+    parser.add_argument("--repeat", type=int, default=1,
+                        help="runs of every case at every level, the levels of a case one "
+                             "after the other (a shared machine's load drifts): the time "
+                             "ratios are the medians of the runs' ratios")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
-    tie(closed_trefoil(nodes=40), tighten_steps=5).run()  # compile the kernels outside the timing
+    if args.repeat < 1:
+        parser.error(f"--repeat must be >= 1, got {args.repeat}")
+    _warm_up(args.levels)
+    cases = [("closed_16.37", lambda lv: closed_case(lv, args.closed_nodes, args.section_path))]
+    cases += [(name, lambda lv, n=name, ln=length, t=target:
+               open_case(lv, args.open_nodes, n, ln, t, args.section_path))
+              for name, length, target in OPEN_CASES]
+    runs: dict[tuple[str, str], list[dict]] = {}
+    for _ in range(args.repeat):
+        for name, run in cases:
+            for level in args.levels:
+                row = run(level)
+                runs.setdefault((name, level), []).append(row)
+                print(json.dumps(row))
     rows = []
-    for level in args.levels:
-        rows.append(closed_case(level, args.closed_nodes, args.section_path))
-        print(json.dumps(rows[-1]))
-        for name, length, target in OPEN_CASES:
-            rows.append(open_case(level, args.open_nodes, name, length, target,
-                                  args.section_path))
-            print(json.dumps(rows[-1]))
-    base = {r["case"]: r for r in rows if r["level"] == args.levels[0]}
-    ratios = [{"case": r["case"], "level": r["level"],
-               "time_ratio_to_" + args.levels[0]: r["wall_time_s"] / base[r["case"]]["wall_time_s"],
-               "iteration_ratio_to_" + args.levels[0]:
-                   r["newton_iterations"] / base[r["case"]]["newton_iterations"]}
-              for r in rows if r["level"] != args.levels[0]]
+    for (name, level), rs in runs.items():
+        walls = [r["wall_time_s"] for r in rs]
+        # the runs are deterministic: the same iterations every time
+        if len({r["newton_iterations"] for r in rs}) != 1:
+            raise SystemExit(f"{name} at {level}: Newton iterations differ between runs")
+        rows.append({**rs[0], "wall_time_s": float(np.median(walls)), "wall_times_s": walls})
+    first = args.levels[0]
+    ratios = []
+    for (name, level), rs in runs.items():
+        if level == first:
+            continue
+        base = runs[(name, first)]
+        per_run = [r["wall_time_s"] / b["wall_time_s"] for r, b in zip(rs, base, strict=True)]
+        ratios.append({"case": name, "level": level,
+                       "time_ratio_to_" + first: float(np.median(per_run)),
+                       "time_ratios_of_runs": per_run,
+                       "iteration_ratio_to_" + first:
+                           rs[0]["newton_iterations"] / base[0]["newton_iterations"]})
     for r in ratios:
         print(json.dumps(r))
     if args.json:
