@@ -76,8 +76,14 @@ def _knot_cost(contact_levels: dict | None, level: str) -> dict[str, Any] | None
     base = {r["case"]: r for r in rows if r.get("level") == "compliant"}
     if not mine:
         return None
-    ratios = [r["wall_time_s"] / base[r["case"]]["wall_time_s"] for r in mine
-              if r["case"] in base and base[r["case"]]["wall_time_s"] > 0]
+    # The bench's own ratios where it repeated the runs (bench/contact_levels.py --repeat:
+    # the median of each run's ratio, the two levels timed one after the other), else the
+    # ratio of the rows' times.
+    own = {r["case"]: r["time_ratio_to_compliant"] for r in contact_levels.get("ratios", [])
+           if r.get("level") == level and "time_ratio_to_compliant" in r}
+    ratios = [own[r["case"]] if r["case"] in own
+              else r["wall_time_s"] / base[r["case"]]["wall_time_s"] for r in mine
+              if r["case"] in own or (r["case"] in base and base[r["case"]]["wall_time_s"] > 0)]
     return {"cases": [r["case"] for r in mine],
             "all_converged": all(r.get("converged") for r in mine),
             "wall_time_s": sum(r["wall_time_s"] for r in mine),
