@@ -18,14 +18,20 @@ from tightknot.solvers.pattern import SparsePattern
 from tightknot.solvers.system import RodSystem
 
 
+def _clamped(points: np.ndarray, load_parameter: float, direction: list[float]) -> RodSystem:
+    """A rod of 1 m along ``points``, clamped at its start, its end loaded by
+    ``load_parameter`` EI/L^2 along ``direction``."""
+    b = RodBuilder()
+    b.add_rod(points, diameter=0.01, material=Material(1e6, 0.5, 1000.0))
+    m = b.finalize()
+    f = load_parameter * 1e6 * second_moment(0.01) * np.asarray(direction, dtype=float)
+    return RodSystem(m, State.initial(m),
+                     BoundaryConditions(m).clamp(0, "start").force(0, -1, f))
+
+
 def _cantilever(n: int = 30, load_parameter: float = 5.0) -> RodSystem:
     x = np.linspace(0.0, 1.0, n)
-    b = RodBuilder()
-    b.add_rod(np.c_[x, 0 * x, 0 * x], diameter=0.01, material=Material(1e6, 0.5, 1000.0))
-    m = b.finalize()
-    f = load_parameter * 1e6 * second_moment(0.01)
-    return RodSystem(m, State.initial(m),
-                     BoundaryConditions(m).clamp(0, "start").force(0, -1, [0, -f, 0]))
+    return _clamped(np.c_[x, 0 * x, 0 * x], load_parameter, [0.0, -1.0, 0.0])
 
 
 def test_non_convergence_is_reported_not_nan() -> None:
@@ -129,15 +135,8 @@ def test_a_batch_rod_is_not_evaluated_alone() -> None:
 def _column(load_parameter: float) -> RodSystem:
     """A clamped column pushed along its axis by ``load_parameter`` EI/L^2 (Euler's
     critical load of a cantilever is pi^2/4 = 2.47 of them), bent slightly to start."""
-    n = 30
-    x = np.linspace(0.0, 1.0, n)
-    b = RodBuilder()
-    b.add_rod(np.c_[x, 1e-3 * x**2, 0 * x], diameter=0.01,
-              material=Material(1e6, 0.5, 1000.0))
-    m = b.finalize()
-    f = load_parameter * 1e6 * second_moment(0.01)
-    system = RodSystem(m, State.initial(m),
-                       BoundaryConditions(m).clamp(0, "start").force(0, -1, [-f, 0, 0]))
+    x = np.linspace(0.0, 1.0, 30)
+    system = _clamped(np.c_[x, 1e-3 * x**2, 0 * x], load_parameter, [-1.0, 0.0, 0.0])
     system.set_load(1.0)
     return system
 

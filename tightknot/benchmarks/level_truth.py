@@ -81,9 +81,12 @@ def _knot_cost(contact_levels: dict | None, level: str) -> dict[str, Any] | None
     # ratio of the rows' times.
     own = {r["case"]: r["time_ratio_to_compliant"] for r in contact_levels.get("ratios", [])
            if r.get("level") == level and "time_ratio_to_compliant" in r}
-    ratios = [own[r["case"]] if r["case"] in own
-              else r["wall_time_s"] / base[r["case"]]["wall_time_s"] for r in mine
-              if r["case"] in own or (r["case"] in base and base[r["case"]]["wall_time_s"] > 0)]
+    ratios = []
+    for r in mine:
+        if r["case"] in own:
+            ratios.append(own[r["case"]])
+        elif r["case"] in base and base[r["case"]]["wall_time_s"] > 0:
+            ratios.append(r["wall_time_s"] / base[r["case"]]["wall_time_s"])
     return {"cases": [r["case"] for r in mine],
             "all_converged": all(r.get("converged") for r in mine),
             "wall_time_s": sum(r["wall_time_s"] for r in mine),

@@ -185,7 +185,7 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
                     break
                 alpha *= 0.5
             if not accepted:
-                mu = opt.shift_initial if mu == 0.0 else mu * 10.0
+                mu = _raised(mu, opt, False)
                 if mu > opt.shift_max:
                     yield from accept(p, u)
                     return NewtonResult(False, it, res, step, energy, "line_search_failed",
