@@ -9,7 +9,9 @@ frames, the interpolation and the contact), and the section's deformation, its c
 width, pressure and area come out of the equilibrium (docs/sectioned_level.md). The energy
 adds to the rod's elastic energy, per edge of rest length h with the coefficients c_0, c_1'
 of its two vertices in its frame (c_1' = Q^T c_1, Q turning mode n by n m, m the reference
-twist to the next edge's frame: the accepted state's, fixed within a Newton iteration):
+twist to the next edge's frame, that of the frames carried to the positions, so that the
+energy is a function of positions and coefficients; its chain rule is
+:mod:`tightknot.contact.section_twist`'s):
 
 * **mode energy**, int (1/2) k_n |c(s)|^2 ds = (k_n h / 6) (|c_0|^2 + c_0 . c_1' + |c_1'|^2)
   per mode, the plane-strain stiffness of an incompressible disk k_n = 2 pi mu (n^2 - 1) / n,
@@ -50,6 +52,11 @@ from tightknot.contact.layer import ContactLayer
 from tightknot.contact.rod_mean_radius import RodMeanRadius
 from tightknot.contact.section_modes import mode_stiffness
 from tightknot.contact.section_shift import MIN_CHORD, SectionShift
+from tightknot.contact.section_twist import (
+    TwistChain,
+    TwistParts,
+    turn_direction,
+)
 from tightknot.rods.model import Model
 from tightknot.rods.staging import Staging
 from tightknot.rods.term import BlockHessian
@@ -317,6 +324,13 @@ class SectionedLayer(ContactLayer):
         pos = m.vertex_dof.astype(np.int64)[:, None] + np.arange(3)
         sec = np.where(offset[:, None] >= 0, m.dof_count + offset[:, None] + np.arange(k), -1)
         self._node_dofs = np.concatenate([pos, sec], axis=1)
+        # The end twists' chain rule (the joint after each deformable edge; none with the
+        # bend shift, whose boundaries are carried in the accepted frames' twist)
+        twist_joint = np.where(self.edge_rigid, -1, nxt)
+        #: The chain rule through the end twists (None: they are held within an iteration).
+        self.twist_chain = (TwistChain(twist_joint, m.joint_vertex, m.vertex_dof,
+                                       self._node_dofs, m.dof_count + self.dof_count)
+                            if self.shift is None else None)
         # The node pairs the section energy always couples (each deformable edge's ends).
         se = ev[self._section_edges]
         pairs = np.concatenate([se, se[:, ::-1], se[:, [0, 0]], se[:, [1, 1]]])
@@ -543,6 +557,7 @@ class SectionedLayer(ContactLayer):
         s_pen = wp.zeros(max(threads * ns, 1), dtype=f64, device=dev)
         s_wt = wp.zeros(max(threads * ns, 1), dtype=f64, device=dev)
         dlam = wp.zeros(2 * threads if with_lam else 1, dtype=f64, device=dev)
+        tcol = wp.zeros(2 * threads * nl if derivatives else 1, dtype=f64, device=dev)
         b = 3 + self.section.coeff_count
         w_slots = wp.array(slots.astype(np.int32).ravel() if derivatives else np.zeros(1, np.int32),
                            dtype=wp.int32, device=dev)
@@ -581,7 +596,8 @@ class SectionedLayer(ContactLayer):
                        part(buf, 1), part(w_slots, 16, derivatives)],
                       [part(energy, 2), part(grad, 2 * nl, derivatives), blocks[i],
                        part(s_pen, 2 * ns, report), part(s_wt, 2 * ns, report),
-                       part(dlam, 4, with_lam)], device=dev)
+                       part(dlam, 4, with_lam), part(tcol, 4 * nl, derivatives)],
+                      device=dev)
 
         if len(chunks) > 1 and kernel.key in self._launched:
             pending = [_chunk_pool().submit(run, i) for i in range(1, len(chunks))]
@@ -610,6 +626,7 @@ class SectionedLayer(ContactLayer):
             for more in blocks[1:]:
                 total = total + more.numpy()
             out["blocks"] = total.reshape(block_count, b, b)
+            out["twist_col"] = unpermuted(tcol, 2 * nl)
         if with_lam:
             out["dlam"] = unpermuted(dlam, 2)
         if report:
@@ -717,10 +734,23 @@ class SectionedLayer(ContactLayer):
                        want_grad: bool, want_hess: bool
                        ) -> tuple[float, np.ndarray | None, np.ndarray | None, tuple | None]:
         """Contact energy [J] of the deformed sections at positions ``x`` [m], vertex
+        sections ``extra`` [m] and edge rest lengths ``rest`` [m], carried in the
+        ``frames`` (t_ref, d1_ref, m): its gradient over positions (V, 3) and over the
+        term's dofs, and its Hessian in node blocks (the section energy's node pairs
+        included, zero), all at the end twists of ``m`` held fixed."""
+        return self._contact_energy(x, extra, frames, rest, want_grad, want_hess, False)[:4]
+
+    def _contact_energy(self, x: np.ndarray, extra: np.ndarray,
+                        frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray,
+                        want_grad: bool, want_hess: bool, twist: bool
+                        ) -> tuple[float, np.ndarray | None, np.ndarray | None, tuple | None,
+                                   TwistParts | None]:
+        """Contact energy [J] of the deformed sections at positions ``x`` [m], vertex
         sections ``extra`` [m] and edge rest lengths ``rest`` [m], carried in the accepted
         ``frames`` (t_ref, d1_ref, m_ref); its gradient over positions (V, 3) and over the
         term's dofs, and its Hessian in node blocks (the section energy's node pairs
-        included, zero)."""
+        included, zero); with ``twist`` and derivatives, also the derivatives in the end
+        twists (:class:`~tightknot.contact.section_twist.TwistParts`, else None)."""
         m = self.model
         rest = np.asarray(rest, dtype=np.float64)
         self.energy.last_rest = rest.copy()
@@ -735,7 +765,7 @@ class SectionedLayer(ContactLayer):
         empty = self._empty_blocks() if want_hess else None
         if npairs == 0:
             self._energy_only = None
-            return 0.0, g_x, g_c, empty
+            return 0.0, g_x, g_c, empty, None
         derivatives = want_grad or want_hess
         last = self._energy_only
         if (derivatives and last is not None and np.array_equal(last[0], x)
@@ -758,11 +788,11 @@ class SectionedLayer(ContactLayer):
                     self._energy_only = (x.copy(), np.array(extra, copy=True), rest.copy(),
                                          tuple(np.array(f, copy=True) for f in frames),
                                          act_pairs)
-                return energy, g_x, g_c, empty
+                return energy, g_x, g_c, empty, None
             if not math.isfinite(energy):
-                return energy, g_x, g_c, empty
+                return energy, g_x, g_c, empty, None
         if act_pairs.shape[0] == 0:
-            return 0.0 if energy is None else energy, g_x, g_c, empty
+            return 0.0 if energy is None else energy, g_x, g_c, empty, None
         wp_act = wp.array(act_pairs.astype(np.int32), dtype=wp.vec2i, device=self.device)
         slots, keys = None, None
         if want_hess:
@@ -779,7 +809,7 @@ class SectionedLayer(ContactLayer):
         if energy is None:
             energy = float(out["energy"].sum())
             if not math.isfinite(energy):
-                return energy, g_x, g_c, empty
+                return energy, g_x, g_c, empty, None
         dofs = self._pass_dofs(act_pairs)  # (2A, L)
         keep = dofs >= 0
         full = np.bincount(dofs[keep], weights=out["grad"][keep],
@@ -801,12 +831,81 @@ class SectionedLayer(ContactLayer):
                 self._add_stretch_blocks(hess, geo, big_g)
                 hess.low_rank = self._rod_mean_low_rank(geo, wx, wp_act, data, slots,
                                                         keys.size, act_pairs, dofs)
+        parts = (self._contact_twist_parts(act_pairs, extra, out, dofs)
+                 if twist and self.twist_chain is not None else None)
         if shifted is not None:
             # derivatives over the offset centreline carried to the centreline
             if hess is not None:
                 hess = shifted.pull_back_hessian(hess, g_x)
             g_x = shifted.pull_back_gradient(g_x)
-        return energy, g_x, g_c, hess
+        return energy, g_x, g_c, hess, parts
+
+    def _contact_twist_parts(self, act_pairs: np.ndarray, extra: np.ndarray,
+                             out: dict[str, np.ndarray], dofs: np.ndarray) -> TwistParts:
+        """The contact's derivatives in the end twists (module :mod:`~tightknot.contact.
+        section_twist`) from the derivative kernel's outputs ``out`` over the passes of
+        ``act_pairs`` (their extended dofs ``dofs``, :meth:`_pass_dofs`)."""
+        k = self.section.coeff_count
+        nl = 12 + 4 * k
+        ev = self._ev
+        order = np.stack([act_pairs, act_pairs[:, ::-1]], axis=1).reshape(-1, 2)  # A, B
+        full = np.zeros((self.model.vertex_count, k))
+        if extra.size:
+            full[~self.vertex_rigid] = extra.reshape(-1, k)
+        grad, tcol = out["grad"], out["twist_col"]
+        keep = dofs >= 0
+        first = np.zeros(self.model.edge_count)
+        col_edge, col_dof, col_value, turns, cols = [], [], [], [], []
+        for side, node in ((0, 1), (1, 3)):
+            # side A's end twist turns its second vertex (local node 1), B's node 3
+            e = order[:, side]
+            v = turn_direction(full[ev[e, 1]], self.modes)
+            coeff = slice(12 + node * k, 12 + (node + 1) * k)
+            first += np.bincount(e, np.einsum("pk,pk->p", grad[:, coeff], v),
+                                 minlength=first.size)
+            col = tcol[:, side * nl:(side + 1) * nl]
+            col_edge.append(np.broadcast_to(e[:, None], dofs.shape)[keep])
+            col_dof.append(dofs[keep])
+            col_value.append(col[keep])
+            turns.append(v)
+            cols.append(col)
+        a1 = slice(12 + k, 12 + 2 * k)
+        b1 = slice(12 + 3 * k, 12 + 4 * k)
+        m_aa = np.einsum("pk,pk->p", turns[0], cols[0][:, a1])
+        m_bb = np.einsum("pk,pk->p", turns[1], cols[1][:, b1])
+        m_ab = np.einsum("pk,pk->p", turns[1], cols[0][:, b1])
+        a, b = order[:, 0], order[:, 1]
+        pair_edge = np.concatenate([np.stack([a, a], axis=1), np.stack([b, b], axis=1),
+                                    np.stack([a, b], axis=1), np.stack([b, a], axis=1)])
+        return TwistParts(first, np.concatenate(col_edge), np.concatenate(col_dof),
+                          np.concatenate(col_value), pair_edge,
+                          np.concatenate([m_aa, m_bb, m_ab, m_ab]))
+
+    def _section_twist_parts(self, extra: np.ndarray, m_ref: np.ndarray,
+                             rest: np.ndarray) -> TwistParts:
+        """The section energy's derivatives in the end twists (its coupling term beta c_0 .
+        Q^T c_1 alone depends on them; :meth:`section_energy`)."""
+        k = self.section.coeff_count
+        e = self._section_edges
+        h = rest[e]
+        twist = self.end_twist(m_ref)[e]
+        beta = self.mode_stiff[e] * h[:, None] / 6.0 - self.grad_stiff[e] / h[:, None]
+        idx0 = self.vertex_offset[self._ev[e, 0]][:, None] + np.arange(k)
+        idx1 = self.vertex_offset[self._ev[e, 1]][:, None] + np.arange(k)
+        c0, c1 = extra[idx0], extra[idx1]
+        c1r = _rotate(c1, self.modes, twist, transpose=True)
+        t1 = turn_direction(c1r, self.modes)
+        first = np.zeros(self.model.edge_count)
+        first[e] = np.sum(beta * c0 * t1, axis=1)
+        col0 = beta * t1
+        col1 = -beta * turn_direction(_rotate(c0, self.modes, twist), self.modes)
+        n2 = np.repeat(self.modes.astype(np.float64) ** 2, 2)
+        second = -np.sum(n2 * beta * c0 * c1r, axis=1)
+        base = self.model.dof_count
+        return TwistParts(first, np.repeat(e, 2 * k),
+                          np.concatenate([base + idx0, base + idx1], axis=1).ravel(),
+                          np.concatenate([col0, col1], axis=1).ravel(),
+                          np.stack([e, e], axis=1), second)
 
     def _empty_blocks(self) -> BlockHessian:
         """The section energy's node pairs with zero blocks."""
@@ -927,18 +1026,34 @@ class SectionedLayer(ContactLayer):
 
     def evaluate_with_dofs(self, x: np.ndarray, extra: np.ndarray,
                            frames: tuple[np.ndarray, np.ndarray, np.ndarray],
-                           rest: np.ndarray, want_grad: bool, want_hess: bool):
+                           rest: np.ndarray, want_grad: bool, want_hess: bool,
+                           twist: np.ndarray | None = None):
         """Section and contact energy [J] at positions ``x`` [m], vertex sections ``extra``
         [m] and edge rest lengths ``rest`` [m], the sections carried in the accepted
         ``frames`` (t_ref, d1_ref, m_ref); gradients over positions and coefficients;
-        Hessian COO over the extended dofs (rods/term.py)."""
+        Hessian in node blocks over the extended dofs (rods/term.py). ``twist``: the
+        reference twist [rad] of the frames carried to ``x`` (the system's trial frames),
+        which the sections then turn with, its chain rule in the derivatives
+        (:mod:`tightknot.contact.section_twist`; not with the bend shift, whose sections
+        keep the accepted frames' twist); None: the accepted ``m_ref``, held."""
         extra = np.asarray(extra, dtype=np.float64)
         rest = np.asarray(rest, dtype=np.float64)
+        chain = twist is not None and self.twist_chain is not None
+        if chain:
+            frames = (frames[0], frames[1], np.asarray(twist, dtype=np.float64))
+        derivatives = want_grad or want_hess
         e_s, g_s, h_s = self.section_energy(extra, frames[2], rest, want_grad, want_hess)
-        e_c, g_x, g_c, h_c = self.contact_energy(x, extra, frames, rest, want_grad, want_hess)
+        e_c, g_x, g_c, h_c, parts = self._contact_energy(
+            x, extra, frames, rest, want_grad, want_hess, chain and derivatives)
         g_own = None if g_s is None else g_s + g_c
         if want_hess:
             self._add_coo(h_c, h_s)
+        if chain and derivatives:
+            both = [self._section_twist_parts(extra, frames[2], rest)]
+            if parts is not None:
+                both.append(parts)
+            g_x, h_c = self.twist_chain.apply(x, TwistParts.join(both), g_x,
+                                              h_c if want_hess else None)
         return e_s + e_c, g_x, g_own, h_c
 
 

@@ -16,8 +16,9 @@ Per sample, every derivative over the L dofs is a combination of 16 reduced dire
 B(phi) + dR/dc, carried to A's two vertices by the interpolation weights), B's boundary at
 the angle psi facing the sample, its slope in psi, and the derivative of B's interpolation
 weights in the projection v. The per-sample Hessian is formed in those 16 directions,
-carried to the pass's dofs and summed over the pass's samples in registers, one block per
-pair of its nodes (the coordinates' 12 x 12, the coordinates against each vertex's
+carried to the pass's dofs (the mean radii's second derivatives in the coefficients, and
+mixed in the stretch and v, added there) and summed over the pass's samples in registers,
+one block per pair of its nodes (the coordinates' 12 x 12, the coordinates against each vertex's
 coefficients, the coefficients' K x K blocks), which are added into the node-pair blocks
 once per pass.
 
@@ -51,6 +52,9 @@ mat6x16d = wp.types.matrix(shape=(6, 16), dtype=wp.float64)
 mat12d = wp.types.matrix(shape=(12, 12), dtype=wp.float64)
 mat12xKd = wp.types.matrix(shape=(12, MAX_COEFF), dtype=wp.float64)
 matKd = wp.types.matrix(shape=(MAX_COEFF, MAX_COEFF), dtype=wp.float64)
+mat6xKd = wp.types.matrix(shape=(6, MAX_COEFF), dtype=wp.float64)
+mat12x6d = wp.types.matrix(shape=(12, 6), dtype=wp.float64)
+vec5d = wp.types.vector(length=5, dtype=wp.float64)
 
 wp.set_module_options({"max_unroll": 1, "enable_backward": False})
 
@@ -516,6 +520,137 @@ def add_pee(target: mat16d, pee: wp.mat33d, row: wp.vec3d, deform_a: int) -> mat
     return target
 
 
+
+@wp.func
+def turn_direction(c: vecKd, k: int) -> vecKd:
+    """d(Q^T(m) c)/dm at m = 0: n J c per mode, (a_n, b_n) -> n (-b_n, a_n)
+    (:func:`turn_modes`' Q^T turns mode n by n m)."""
+    out = vecKd()
+    for j in range(k // 2):
+        n = f64(2 + j)
+        out[2 * j] = -n * c[2 * j + 1]
+        out[2 * j + 1] = n * c[2 * j]
+    return out
+
+
+@wp.func
+def twist_column(out: wp.array(dtype=wp.float64), to: int, grad: wp.array(dtype=wp.float64),
+                 g_at: int, v: vecKd, k: int, node: int, h_x: mat12xKd, h_0: matKd,
+                 h_1: matKd, h_2: matKd, h_3: matKd):
+    """Write H[y, c] v over the pass's local dofs y, c the coefficients of local node
+    ``node`` (1: A's second vertex, 3: B's), v = n J c (:func:`turn_direction`), plus
+    (n J)^T grad_c (the gradient at ``grad[g_at:]``) on c's rows. ``h_x``: the coordinates
+    against c (12 x k); ``h_0`` .. ``h_3``: the coefficient blocks of the four nodes
+    against c's node as the pass holds them: for node 1, (A0, A1) [A0 row], (A1, A1)
+    upper, (A1, B0) and (A1, B1) [A1 row]; for node 3, (A0, B1), (A1, B1), (B0, B1)
+    [B1 column] and (B1, B1) upper."""
+    for i in range(12):
+        s = f64(0.0)
+        for j in range(k):
+            s += h_x[i, j] * v[j]
+        out[to + i] = s
+    for i in range(k):
+        s0 = f64(0.0)
+        s1 = f64(0.0)
+        s2 = f64(0.0)
+        s3 = f64(0.0)
+        for j in range(k):
+            if node == 1:
+                s0 += h_0[i, j] * v[j]
+                if j >= i:
+                    s1 += h_1[i, j] * v[j]
+                else:
+                    s1 += h_1[j, i] * v[j]
+                s2 += h_2[j, i] * v[j]
+                s3 += h_3[j, i] * v[j]
+            else:
+                s0 += h_0[i, j] * v[j]
+                s1 += h_1[i, j] * v[j]
+                s2 += h_2[i, j] * v[j]
+                if j >= i:
+                    s3 += h_3[i, j] * v[j]
+                else:
+                    s3 += h_3[j, i] * v[j]
+        out[to + 12 + i] = s0
+        out[to + 12 + k + i] = s1
+        out[to + 12 + 2 * k + i] = s2
+        out[to + 12 + 3 * k + i] = s3
+    # (n J)^T grad_c on c's own rows: (g_a, g_b) -> n (g_b, -g_a)
+    row = to + 12 + node * k
+    for j in range(k // 2):
+        n = f64(2 + j)
+        out[row + 2 * j] = out[row + 2 * j] + n * grad[g_at + 2 * j + 1]
+        out[row + 2 * j + 1] = out[row + 2 * j + 1] - n * grad[g_at + 2 * j]
+
+
+
+@wp.func
+def qt_entry(cs: vecKd, sn: vecKd, i: int, j: int) -> wp.float64:
+    """Entry (i, j) of Q^T: per mode [[cos, -sin], [sin, cos]] (:func:`turn_modes`)."""
+    qt = f64(0.0)
+    if i // 2 == j // 2:
+        mo = i // 2
+        if i % 2 == j % 2:
+            qt = cs[mo]
+        elif i % 2 == 0:
+            qt = -sn[mo]
+        else:
+            qt = sn[mo]
+    return qt
+
+
+@wp.func
+def radius_cc(h00: matKd, h01: matKd, h11: matKd, g: wp.float64, c: vecKd, qc: vecKd,
+              big_r: wp.float64, w0: wp.float64, w1: wp.float64, cs: vecKd, sn: vecKd,
+              k: int):
+    """``g`` times a mean radius's R_cc = -I / (2 R) - c c^T / (4 R^3) added to an edge's
+    coefficient blocks, c = w0 c_0 + w1 Q^T c_1 (``qc`` = Q c; Q's cosines and sines
+    ``cs``, ``sn``): w0^2 R_cc on (0, 0), w0 w1 R_cc Q^T on (0, 1), w1^2 Q R_cc Q^T on (1, 1)
+    (the diagonal blocks' upper triangles)."""
+    ia = g / (f64(2.0) * big_r)
+    ib = g / (f64(4.0) * big_r * big_r * big_r)
+    for i in range(k):
+        for j in range(k):
+            h01[i, j] = h01[i, j] + w0 * w1 * (-ia * qt_entry(cs, sn, i, j) - ib * c[i] * qc[j])
+            if j >= i:
+                d0 = -ib * c[i] * c[j]
+                d1 = -ib * qc[i] * qc[j]
+                if i == j:
+                    d0 = d0 - ia
+                    d1 = d1 - ia
+                h00[i, j] = h00[i, j] + w0 * w0 * d0
+                h11[i, j] = h11[i, j] + w1 * w1 * d1
+    return h00, h01, h11
+
+
+@wp.func
+def radius_moments(h00: matKd, h01: matKd, h11: matKd, mom_a: wp.vec3d, mom_b: vec5d,
+                   c0: vecKd, c1: vecKd, qc0: vecKd, qc1: vecKd, cs: vecKd, sn: vecKd,
+                   k: int):
+    """A partner's R_cc summed over a pass's samples at c(v) = (1 - v) c0 + v c1 (``qc0``,
+    ``qc1`` = Q c0, Q c1): ``mom_a`` = sum g / (2 R) ((1 - v)^2, (1 - v) v, v^2) and
+    ``mom_b`` = sum g / (4 R^3) (1 - v)^(4 - i) v^i, i = 0 .. 4, added to the blocks as
+    :func:`radius_cc` adds one sample's."""
+    for i in range(k):
+        for j in range(k):
+            h01[i, j] = h01[i, j] - (mom_a[1] * qt_entry(cs, sn, i, j)
+                                     + mom_b[1] * c0[i] * qc0[j]
+                                     + mom_b[2] * (c0[i] * qc1[j] + c1[i] * qc0[j])
+                                     + mom_b[3] * c1[i] * qc1[j])
+            if j >= i:
+                d0 = (mom_b[0] * c0[i] * c0[j] + mom_b[1] * (c0[i] * c1[j] + c1[i] * c0[j])
+                      + mom_b[2] * c1[i] * c1[j])
+                d1 = (mom_b[2] * qc0[i] * qc0[j]
+                      + mom_b[3] * (qc0[i] * qc1[j] + qc1[i] * qc0[j])
+                      + mom_b[4] * qc1[i] * qc1[j])
+                if i == j:
+                    d0 = d0 + mom_a[0]
+                    d1 = d1 + mom_a[2]
+                h00[i, j] = h00[i, j] - d0
+                h11[i, j] = h11[i, j] - d1
+    return h00, h01, h11
+
+
 def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
     """The pass kernel's variant: energy only, or with the gradient and Hessian
     (``derivatives``); ``report`` also writes each sample's penetration and weight."""
@@ -562,6 +697,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         sample_pen_out: wp.array(dtype=wp.float64),
         sample_weight_out: wp.array(dtype=wp.float64),
         dlam_out: wp.array(dtype=wp.float64),
+        twist_col_out: wp.array(dtype=wp.float64),
     ):
         tid = wp.tid()
         pr = pairs_in[tid // 2]
@@ -677,6 +813,11 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             h_b0b0 = matKd()
             h_b0b1 = matKd()
             h_b1b1 = matKd()
+        # B's radius sums over the pass (the samples' moments in v) and the v terms
+        mom_a = wp.vec3d()
+        mom_g = wp.vec3d()
+        mom_b = vec5d()
+        zx = mat12x6d()
         for gi in range(ng):
             u = gauss_xi[gi]
             xu = xa0 + u * vec_a
@@ -688,6 +829,9 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 continue
             ca = (f64(1.0) - u) * ca0 + u * ca1
             ra_mean, ra_l, ra_ll = radius_partials(ca, k, rig_a, edge_r0[ea], base_a)
+            ga_sum = f64(0.0)
+            za = mat6xKd()
+            hit = int(0)
             if ra_mean <= f64(0.0):
                 energy_out[tid] = f64(1.0e300)
                 return
@@ -924,8 +1068,113 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                                     h_a0b1[i, j] = h_a0b1[i, j] + wa0[i] * t1[j]
                                     h_a1b0[i, j] = h_a1b0[i, j] + wa1[i] * t0[j]
                                     h_a1b1[i, j] = h_a1b1[i, j] + wa1[i] * t1[j]
+                    # The mean radii's second derivatives (the oracle's _radius_second),
+                    # gathered as sums over the samples and added per Gauss circle (A's)
+                    # and per pass (B's): R = sqrt(S(lam) - |c|^2 / 2) has R_cc = -I / (2 R)
+                    # - c c^T / (4 R^3) and R_clam = c R_lam / (2 R^2). A's c is the
+                    # circle's; B's c(v) = (1 - v) c_B0 + v c_B1' spans two vectors, and
+                    # R_cc dc/dv = z = -dc / (2 R) - (c . dc) c / (4 R^3) three (dc_b, c_B0,
+                    # c_B1'), so sums of moments in v carry them.
+                    hit = 1
+                    if rig_a == 0:
+                        ga_sum += r_grad[12]
+                    if rig_b == 0:
+                        al = c_g / (f64(2.0) * rb_mean)
+                        be = c_g / (f64(4.0) * rb_mean * rb_mean * rb_mean)
+                        ga = c_g * rb_lx / (f64(2.0) * rb_mean * rb_mean)
+                        mv = wp.vec3d(one_v * one_v, one_v * v, v * v)
+                        mom_a = mom_a + al * mv
+                        mom_g = mom_g + ga * mv
+                        w4 = one_v * one_v
+                        w4 = w4 * w4
+                        mom_b[0] = mom_b[0] + be * w4
+                        mom_b[1] = mom_b[1] + be * one_v * one_v * one_v * v
+                        mom_b[2] = mom_b[2] + be * one_v * one_v * v * v
+                        mom_b[3] = mom_b[3] + be * one_v * v * v * v
+                        mom_b[4] = mom_b[4] + be * v * v * v * v
+                        # z's coordinates on (dc_b, c_B0, c_B1') times c_g, for the two
+                        # vertices' weights (1 - v), v
+                        cdc = wp.dot(cb, dcb) / (f64(4.0) * rb_mean * rb_mean * rb_mean)
+                        zc = wp.vec3d(-f64(1.0) / (f64(2.0) * rb_mean), -cdc * one_v, -cdc * v)
+                        for q in range(3):
+                            for i in range(12):
+                                zx[i, q] = zx[i, q] + c_g * one_v * zc[q] * jq[i]
+                                zx[i, 3 + q] = zx[i, 3 + q] + c_g * v * zc[q] * jq[i]
+                            if rig_a == 0:
+                                for j in range(k):
+                                    za[q, j] = za[q, j] + c_g * jq[12] * one_v * zc[q] * ba[j]
+                                    za[3 + q, j] = za[3 + q, j] + c_g * jq[12] * v * zc[q] * ba[j]
                     touched = 1
+            if wp.static(derivatives):
+                if hit != 0:
+                    # this circle's sums (A's radius and the v terms against A's direction)
+                    one_u = f64(1.0) - u
+                    if rig_a == 0:
+                        qca = turn_modes(ca, turn_ac, turn_as, k, 0)
+                        h_a0a0, h_a0a1, h_a1a1 = radius_cc(h_a0a0, h_a0a1, h_a1a1, ga_sum, ca, qca,
+                                                           ra_mean, one_u, u, turn_ac, turn_as, k)
+                        ra_lx = ra_l
+                        if rod_mean != 0:
+                            ra_lx = f64(0.0)
+                        wla = (ga_sum * ra_lx / (f64(2.0) * ra_mean * ra_mean)) * ca
+                        qwla = turn_modes(wla, turn_ac, turn_as, k, 0)
+                        for r in range(3):
+                            dl = ta[r] / rest_in[ea]
+                            for j in range(k):
+                                h_xa0[r, j] = h_xa0[r, j] - dl * one_u * wla[j]
+                                h_xa0[3 + r, j] = h_xa0[3 + r, j] + dl * one_u * wla[j]
+                                h_xa1[r, j] = h_xa1[r, j] - dl * u * qwla[j]
+                                h_xa1[3 + r, j] = h_xa1[3 + r, j] + dl * u * qwla[j]
+                    if rig_a == 0 and rig_b == 0:
+                        for q in range(3):
+                            zv = dcb
+                            if q == 1:
+                                zv = cb0
+                            elif q == 2:
+                                zv = cb1
+                            qzv = turn_modes(zv, turn_bc, turn_bs, k, 0)
+                            y0 = vecKd()
+                            y1 = vecKd()
+                            for j in range(k):
+                                y0[j] = za[q, j]
+                                y1[j] = za[3 + q, j]
+                            qy0 = turn_modes(y0, turn_ac, turn_as, k, 0)
+                            qy1 = turn_modes(y1, turn_ac, turn_as, k, 0)
+                            for i in range(k):
+                                for j in range(k):
+                                    h_a0b0[i, j] = h_a0b0[i, j] + one_u * y0[i] * zv[j]
+                                    h_a1b0[i, j] = h_a1b0[i, j] + u * qy0[i] * zv[j]
+                                    h_a0b1[i, j] = h_a0b1[i, j] + one_u * y1[i] * qzv[j]
+                                    h_a1b1[i, j] = h_a1b1[i, j] + u * qy1[i] * qzv[j]
         if wp.static(derivatives):
+            if rig_b == 0 and touched != 0:
+                # B's sums over the pass: R_cc on its coefficients, R_clam against its
+                # stretch, z against the positions (through v)
+                qcb0 = turn_modes(cb0, turn_bc, turn_bs, k, 0)
+                qcb1 = turn_modes(cb1, turn_bc, turn_bs, k, 0)
+                h_b0b0, h_b0b1, h_b1b1 = radius_moments(h_b0b0, h_b0b1, h_b1b1, mom_a, mom_b,
+                                                        cb0, cb1, qcb0, qcb1, turn_bc,
+                                                        turn_bs, k)
+                wl0 = mom_g[0] * cb0 + mom_g[1] * cb1
+                wl1 = turn_modes(mom_g[1] * cb0 + mom_g[2] * cb1, turn_bc, turn_bs, k, 0)
+                for r in range(3):
+                    dl = tb[r] / rest_in[eb]
+                    for j in range(k):
+                        h_xb0[6 + r, j] = h_xb0[6 + r, j] - dl * wl0[j]
+                        h_xb0[9 + r, j] = h_xb0[9 + r, j] + dl * wl0[j]
+                        h_xb1[6 + r, j] = h_xb1[6 + r, j] - dl * wl1[j]
+                        h_xb1[9 + r, j] = h_xb1[9 + r, j] + dl * wl1[j]
+                for q in range(3):
+                    zv = dcb
+                    if q == 1:
+                        zv = cb0
+                    elif q == 2:
+                        zv = cb1
+                    qzv = turn_modes(zv, turn_bc, turn_bs, k, 0)
+                    for i in range(12):
+                        for j in range(k):
+                            h_xb0[i, j] = h_xb0[i, j] + zx[i, q] * zv[j]
+                            h_xb1[i, j] = h_xb1[i, j] + zx[i, 3 + q] * qzv[j]
             if touched != 0:
                 pair = tid // 2
                 flip = tid % 2
@@ -950,6 +1199,23 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 0, 3, h_a0b1, 0)
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 2, h_a1b0, 0)
                     scatter_coeff(blocks_out, slots_in, pair, flip, bsz, k, 1, 3, h_a1b1, 0)
+            if touched != 0:
+                # The pass's second derivatives against each side's end twist m (the
+                # reference twist that turns the side's second vertex's coefficients into
+                # its edge's frame): the energy sees m and c_1 only through Q^T(m) c_1, so
+                # d/dm = grad_c1 . (n J c_1) and d2/(dm dy) = H[y, c_1] n J c_1, plus
+                # (n J)^T grad_c1 on c_1's own rows (the host's chain rule through m(x)).
+                to = tid * 2 * nl
+                if rig_a == 0:
+                    twist_column(twist_col_out, to, grad_out, go + 12 + k,
+                                 turn_direction(load_section(coeff_in, vertex_offset[va[1]], k),
+                                                k),
+                                 k, 1, h_xa1, h_a0a1, h_a1a1, h_a1b0, h_a1b1)
+                if rig_b == 0:
+                    twist_column(twist_col_out, to + nl, grad_out, go + 12 + 3 * k,
+                                 turn_direction(load_section(coeff_in, vertex_offset[vb[1]], k),
+                                                k),
+                                 k, 3, h_xb1, h_a0b1, h_a1b1, h_b0b1, h_b1b1)
         if wp.static(derivatives):
             if rod_mean != 0:
                 dlam_out[2 * tid] = dlam_a

@@ -7,7 +7,8 @@ coefficients c_v = (a_2, b_2, ..., a_N, b_N) in the frame of the edge that start
 edge that ends at v for the last vertex of an open rod). Along an edge the coefficients are
 interpolated linearly between its two vertices, c(u) = (1 - u) c_0 + u Q^T c_1, where Q
 rotates each mode n by n m, m the reference twist between the edge's frame and the next
-edge's (the frame c_1 is stored in; the accepted state's, fixed within a Newton iteration),
+edge's (the frame c_1 is stored in; an input here: the level turns it with the positions,
+:mod:`tightknot.contact.section_twist`),
 so that a section deformed along a contact varies continuously, as in the solid. The mean
 radius follows from the area, R^2 = r0^2 lambda^(-2 nu) - (1/2) |c(u)|^2 (Parseval; the
 area thins as lambda^(-2 nu) with the edge's stretch lambda, nu = 1/2 for the
@@ -36,10 +37,10 @@ rounded penalty of :func:`tightknot.contact.section_squeeze.rounded_penalty`
 (kappa pen^2 / 2 past a cubic onset).
 
 Derivatives: the gradient is exact (every dependence above, the frames' through the
-transport and the partner's section through v included). So is the Hessian, but for terms
-of relative order pen / R (the mean radii's second derivatives in the coefficients and
-their mixed ones in the stretch and v) and the frames' second derivatives, which are central
-differences of their exact first ones (:data:`FRAME_STEP`): b's cylinder coordinates
+transport and the partner's section through v included). So is the Hessian, the mean radii's
+second derivatives in the coefficients and their mixed ones in the stretch and v included,
+but for the frames' second derivatives, which are central differences of their exact first
+ones (:data:`FRAME_STEP`): b's cylinder coordinates
 (v, rho, psi) of a sample carry their exact Hessians over (P - x_b0, x_b1 - x_b0)
 (:func:`cylinder_coordinates`), and P its own over a's edge vector.
 
@@ -482,8 +483,49 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
             h -= ph1 * wt1 * (np.outer(grad_g, grad_v) + np.outer(grad_v, grad_g))
             h += ph * (wt2 * np.outer(grad_v, grad_v) + wt1 * hvl)
             hess += a_s * h
+            # The mean radii's second derivatives in the coefficients, and mixed in the
+            # stretch and (b's) in v, times dE/dr: R = sqrt(S(lam) - |c|^2 / 2) has
+            # R_cc = -I / (2 R) - c c^T / (4 R^3) and R_clam = c R_lam / (2 R^2).
+            if not ea_.rigid:
+                g_alpha = a_s * (-wt * ph1 * float(g_we[:3] @ dirv)
+                                 + ph * wt1 * float(gv[:3] @ dirv))
+                map_a = np.zeros((nloc, k))
+                map_a[12:12 + k] = (1.0 - u) * np.eye(k)
+                map_a[12 + k:12 + 2 * k] = rot_a.T
+                hess += g_alpha * _radius_second(map_a, ca, ra_mean, ra_l, ta / ea_.rest,
+                                                 ia0, ia1, None)
+            if not eb_.rigid:
+                map_b = np.zeros((nloc, k))
+                map_b[12 + 2 * k:12 + 3 * k] = (1.0 - v) * np.eye(k)
+                map_b[12 + 3 * k:] = rot_b.T
+                hess += a_s * wt * ph1 * _radius_second(map_b, cb, rb_mean, rb_l,
+                                                        tb / eb_.rest, ib0, ib1,
+                                                        (dcb, grad_v))
     return {"energy": energy, "grad": grad, "hess": hess, "pen": np.array(pens),
             "weight": np.array(weights)}
+
+
+def _radius_second(cmap: NDArray, c: NDArray, big_r: float, r_lam: float,
+                   lam_dir: NDArray, i0: slice, i1: slice,
+                   along_v: tuple[NDArray, NDArray] | None) -> NDArray:
+    """The second derivatives of a mean radius R(lam, c) over the local dofs (L, L):
+    R_cc carried by ``cmap`` (dc/d(local coefficients), (L, K)) from the coefficients ``c``
+    [m] at the point, R_clam against the stretch lam = |x_1 - x_0| / rest (d lam / dx_1 =
+    ``lam_dir`` on the edge's positions ``i0``, ``i1``) and, with ``along_v`` = (dc/dv,
+    dv/d(local)), R_cc dc/dv against v (a partner's c(v) at its projection v)."""
+    k = c.size
+    rcc = -np.eye(k) / (2.0 * big_r) - np.outer(c, c) / (4.0 * big_r**3)
+    out = cmap @ rcc @ cmap.T
+    lam = np.zeros(cmap.shape[0])
+    lam[i1] = lam_dir
+    lam[i0] = -lam_dir
+    col = cmap @ (c * r_lam / (2.0 * big_r**2))
+    out += np.outer(col, lam) + np.outer(lam, col)
+    if along_v is not None:
+        dc_dv, v_local = along_v
+        col = cmap @ (rcc @ dc_dv)
+        out += np.outer(col, v_local) + np.outer(v_local, col)
+    return out
 
 
 def swap_order(k: int) -> NDArray:

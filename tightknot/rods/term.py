@@ -80,7 +80,8 @@ class EnergyTerm(Protocol):
 
     def evaluate_with_dofs(self, x: np.ndarray, extra: np.ndarray,
                            frames: tuple[np.ndarray, np.ndarray, np.ndarray],
-                           rest: np.ndarray, want_grad: bool, want_hess: bool
+                           rest: np.ndarray, want_grad: bool, want_hess: bool,
+                           twist: np.ndarray | None = None
                            ) -> tuple[float, np.ndarray | None, np.ndarray | None,
                                       BlockHessian | None]:
         """For a term with dofs of its own: the energy [J] at positions ``x`` [m] (V, 3),
@@ -88,7 +89,8 @@ class EnergyTerm(Protocol):
         frames ``frames`` = (t_ref, d1_ref, m_ref) (unit tangents and reference directors
         per edge, reference twist per joint [rad]); its gradient over the positions (V, 3)
         [N] and over its dofs (dof_count,), and its Hessian in node blocks over the extended
-        dofs (:class:`BlockHessian`; None where not asked)."""
+        dofs (:class:`BlockHessian`; None where not asked). ``twist``: the reference twist
+        per joint [rad] of the frames carried to ``x`` (None: the accepted ``m_ref``)."""
         raise NotImplementedError(f"{type(self).__name__} owns no dofs")
 
     def begin_load_step(self, x: np.ndarray, rest: np.ndarray) -> None:

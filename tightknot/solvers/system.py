@@ -263,9 +263,10 @@ class RodSystem:
         low_rank = []
         for term in self.extra_terms:
             if term is self.dof_term:
+                # the sections turn with the reference twist of the frames carried to x
                 e_k, g_k, g_own, h_own = term.evaluate_with_dofs(
                     x, u[n_model:], st.frames, self.rest,
-                    want_grad or want_hess, want_hess)
+                    want_grad or want_hess, want_hess, twist=mref)
                 split.extra[term.name] = e_k
                 if grad is not None and g_k is not None:
                     grad[m.position_dofs] += g_k
@@ -328,7 +329,7 @@ class RodSystem:
         st = self.state
         if term is self.dof_term:
             return term.evaluate_with_dofs(st.x, st.extra, st.frames,
-                                           self.rest, True, False)[1]
+                                           self.rest, True, False, twist=st.m_ref)[1]
         return term.evaluate(st.x, self.rest, True, False)[1]
 
     def evaluated(self, u: np.ndarray, x: np.ndarray, theta: np.ndarray, answer: Any,
