@@ -199,6 +199,17 @@ def mode_turn(angle: wp.float64, k: int):
 
 
 @wp.func
+def b_moment_row(q: int, dcb: vecKd, cb0: vecKd, cb1: vecKd) -> vecKd:
+    """The coefficient vector that B's z-moment ``q`` multiplies: 0 the difference
+    c_b1 - c_b0 over the pass (``dcb``), 1 c_b0, 2 c_b1."""
+    if q == 1:
+        return cb0
+    if q == 2:
+        return cb1
+    return dcb
+
+
+@wp.func
 def turn_modes(c: vecKd, cs: vecKd, sn: vecKd, k: int, transpose: int) -> vecKd:
     """Q c, or Q^T c (transpose != 0), with Q's cosines and sines ``cs``, ``sn``
     (:func:`mode_turn`)."""
@@ -1127,11 +1138,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                                 h_xa1[3 + r, j] = h_xa1[3 + r, j] + dl * u * qwla[j]
                     if rig_a == 0 and rig_b == 0:
                         for q in range(3):
-                            zv = dcb
-                            if q == 1:
-                                zv = cb0
-                            elif q == 2:
-                                zv = cb1
+                            zv = b_moment_row(q, dcb, cb0, cb1)
                             qzv = turn_modes(zv, turn_bc, turn_bs, k, 0)
                             y0 = vecKd()
                             y1 = vecKd()
@@ -1165,11 +1172,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         h_xb1[6 + r, j] = h_xb1[6 + r, j] - dl * wl1[j]
                         h_xb1[9 + r, j] = h_xb1[9 + r, j] + dl * wl1[j]
                 for q in range(3):
-                    zv = dcb
-                    if q == 1:
-                        zv = cb0
-                    elif q == 2:
-                        zv = cb1
+                    zv = b_moment_row(q, dcb, cb0, cb1)
                     qzv = turn_modes(zv, turn_bc, turn_bs, k, 0)
                     for i in range(12):
                         for j in range(k):
