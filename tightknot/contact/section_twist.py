@@ -42,14 +42,6 @@ def turn_direction(c: np.ndarray, modes: np.ndarray) -> np.ndarray:
     return out
 
 
-def turn_direction_t(g: np.ndarray, modes: np.ndarray) -> np.ndarray:
-    """(n J)^T g for rows ``g`` (R, K): (g_a, g_b) -> n (g_b, -g_a)."""
-    out = np.empty_like(g)
-    out[:, 0::2] = modes * g[:, 1::2]
-    out[:, 1::2] = -modes * g[:, 0::2]
-    return out
-
-
 def _skew(v: np.ndarray) -> np.ndarray:
     """Cross-product matrices [v]x of rows ``v`` (R, 3)."""
     z = np.zeros(v.shape[0])

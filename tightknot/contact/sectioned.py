@@ -411,14 +411,20 @@ class SectionedLayer(ContactLayer):
         out[has] = m_ref[nxt[has]]
         return out
 
-    def edge_sections(self, extra: np.ndarray, m_ref: np.ndarray
-                      ) -> tuple[np.ndarray, np.ndarray]:
-        """Each edge's (E, K) coefficients [m] at its first vertex and at its second, both
-        in the edge's frame (zero on rigid sections)."""
+    def vertex_sections(self, extra: np.ndarray) -> np.ndarray:
+        """Each vertex's (V, K) coefficients [m] as stored, in the frame of the edge it
+        starts (zero on rigid sections)."""
         k = self.section.coeff_count
         full = np.zeros((self.model.vertex_count, k))
         if extra.size:
             full[~self.vertex_rigid] = extra.reshape(-1, k)
+        return full
+
+    def edge_sections(self, extra: np.ndarray, m_ref: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """Each edge's (E, K) coefficients [m] at its first vertex and at its second, both
+        in the edge's frame (zero on rigid sections)."""
+        full = self.vertex_sections(extra)
         c0 = full[self._ev[:, 0]]
         c1 = _rotate(full[self._ev[:, 1]], self.modes, self.end_twist(m_ref), transpose=True)
         return c0, c1
@@ -452,18 +458,13 @@ class SectionedLayer(ContactLayer):
         out[ok] = _rotate(old[src[ok]], self.modes, angle[ok])
         return out.ravel()
 
-    def section_energy(self, extra: np.ndarray, m_ref: np.ndarray, rest: np.ndarray,
-                       want_grad: bool, want_hess: bool
-                       ) -> tuple[float, np.ndarray | None, tuple | None]:
-        """Mode and axial-gradient energy [J] of the vertex sections ``extra`` [m] at edge
-        rest lengths ``rest`` [m] and joint reference twists ``m_ref`` [rad] (module
-        docstring), its gradient over ``extra`` and its Hessian COO over the term's dofs."""
+    def _section_edge_terms(self, extra: np.ndarray, m_ref: np.ndarray, rest: np.ndarray
+                            ) -> tuple[np.ndarray, ...]:
+        """Per deformable edge (``_section_edges``) the pieces of the section energy: its end
+        twist [rad], alpha and beta [N/m] per coefficient, its vertices' first dofs among
+        the term's and their (E, K) dof indices, and c_0, c_1, c_1' = Q^T c_1 [m]."""
         k = self.section.coeff_count
         e = self._section_edges
-        grad = np.zeros(extra.size) if (want_grad or want_hess) else None
-        if e.size == 0:
-            empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
-            return 0.0, grad, (empty if want_hess else None)
         h = rest[e]
         twist = self.end_twist(m_ref)[e]
         # per edge and coefficient: alpha = k h / 3 + g / h, beta = k h / 6 - g / h
@@ -476,6 +477,22 @@ class SectionedLayer(ContactLayer):
         c0 = extra[idx0]
         c1 = extra[idx1]
         c1r = _rotate(c1, self.modes, twist, transpose=True)  # c_1' = Q^T c_1
+        return twist, alpha, beta, off0, off1, idx0, idx1, c0, c1, c1r
+
+    def section_energy(self, extra: np.ndarray, m_ref: np.ndarray, rest: np.ndarray,
+                       want_grad: bool, want_hess: bool
+                       ) -> tuple[float, np.ndarray | None, tuple | None]:
+        """Mode and axial-gradient energy [J] of the vertex sections ``extra`` [m] at edge
+        rest lengths ``rest`` [m] and joint reference twists ``m_ref`` [rad] (module
+        docstring), its gradient over ``extra`` and its Hessian COO over the term's dofs."""
+        k = self.section.coeff_count
+        e = self._section_edges
+        grad = np.zeros(extra.size) if (want_grad or want_hess) else None
+        if e.size == 0:
+            empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+            return 0.0, grad, (empty if want_hess else None)
+        twist, alpha, beta, off0, off1, idx0, idx1, c0, c1, c1r = self._section_edge_terms(
+            extra, m_ref, rest)
         energy = float(np.sum(0.5 * alpha * (c0 * c0 + c1 * c1) + beta * c0 * c1r))
         if grad is not None:
             np.add.at(grad, idx0, alpha * c0 + beta * c1r)
@@ -849,9 +866,7 @@ class SectionedLayer(ContactLayer):
         nl = 12 + 4 * k
         ev = self._ev
         order = np.stack([act_pairs, act_pairs[:, ::-1]], axis=1).reshape(-1, 2)  # A, B
-        full = np.zeros((self.model.vertex_count, k))
-        if extra.size:
-            full[~self.vertex_rigid] = extra.reshape(-1, k)
+        full = self.vertex_sections(extra)
         grad, tcol = out["grad"], out["twist_col"]
         keep = dofs >= 0
         first = np.zeros(self.model.edge_count)
@@ -887,13 +902,8 @@ class SectionedLayer(ContactLayer):
         Q^T c_1 alone depends on them; :meth:`section_energy`)."""
         k = self.section.coeff_count
         e = self._section_edges
-        h = rest[e]
-        twist = self.end_twist(m_ref)[e]
-        beta = self.mode_stiff[e] * h[:, None] / 6.0 - self.grad_stiff[e] / h[:, None]
-        idx0 = self.vertex_offset[self._ev[e, 0]][:, None] + np.arange(k)
-        idx1 = self.vertex_offset[self._ev[e, 1]][:, None] + np.arange(k)
-        c0, c1 = extra[idx0], extra[idx1]
-        c1r = _rotate(c1, self.modes, twist, transpose=True)
+        twist, _, beta, _, _, idx0, idx1, c0, _, c1r = self._section_edge_terms(
+            extra, m_ref, rest)
         t1 = turn_direction(c1r, self.modes)
         first = np.zeros(self.model.edge_count)
         first[e] = np.sum(beta * c0 * t1, axis=1)

@@ -531,7 +531,6 @@ def add_pee(target: mat16d, pee: wp.mat33d, row: wp.vec3d, deform_a: int) -> mat
     return target
 
 
-
 @wp.func
 def turn_direction(c: vecKd, k: int) -> vecKd:
     """d(Q^T(m) c)/dm at m = 0: n J c per mode, (a_n, b_n) -> n (-b_n, a_n)
@@ -592,7 +591,6 @@ def twist_column(out: wp.array(dtype=wp.float64), to: int, grad: wp.array(dtype=
         n = f64(2 + j)
         out[row + 2 * j] = out[row + 2 * j] + n * grad[g_at + 2 * j + 1]
         out[row + 2 * j + 1] = out[row + 2 * j + 1] - n * grad[g_at + 2 * j]
-
 
 
 @wp.func
