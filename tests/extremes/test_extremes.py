@@ -368,10 +368,9 @@ def test_a_long_rods_levels_are_refined_to_its_own_resolution() -> None:
 @extremes
 def test_the_sectioned_hard_pull_converges_with_the_strands_apart() -> None:
     # 30 N on the 125 mm knot at the sectioned level (150 vertices): converged, a trefoil,
-    # min gap >= the 0.3 D0 (measured 0.40 D0, Lambda_OC 6.54, 1156 Newton
-    # iterations, 70 s; unfinished after 30 minutes before the reference twist's chain rule:
-    # docs/sectioned_level.md), and the summary says its sections left the FEM-judged range
-    # (min A/A0 0.325 against 0.693).
+    # min gap >= the 0.3 D0 (measured 0.40 D0, Lambda_OC 6.54: docs/sectioned_level.md),
+    # and the summary says its sections left the FEM-judged range (min A/A0 0.325 against
+    # 0.693).
     from tightknot.knots.scenes import open_trefoil
     from tightknot.study.run import run_knot
 
