@@ -145,6 +145,28 @@ def test_the_pull_back_matches_finite_differences() -> None:
             assert np.max(np.abs(own - own_fd)) <= 1e-6 * max(np.max(np.abs(own_fd)), 1e-30)
 
 
+def test_entries_pulled_back_are_the_gradients_pull_back() -> None:
+    # Sparse entries of a vector over x~ (the twist chain's columns, one per edge) carried
+    # to x entry by entry sum to J^T v of the dense vector (the gradient's pull-back).
+    model = _model([_wavy(40, 0)])
+    shift = SectionShift(model).at(model.vertex_initial_position, model.edge_rest_length)
+    rng = np.random.default_rng(3)
+    vertex = rng.integers(0, model.vertex_count, size=30)
+    comp = rng.integers(0, 3, size=30)
+    value = rng.normal(size=30)
+    dense = np.zeros((model.vertex_count, 3))
+    np.add.at(dense, (vertex, comp), value)
+    src, w, c, val = shift.pull_back_entries(vertex, comp, value)
+    assert np.all(val != 0.0) and src.max() < vertex.size
+    out = np.zeros_like(dense)
+    np.add.at(out, (w, c), val)
+    expect = shift.pull_back_gradient(dense)
+    assert np.max(np.abs(out - expect)) <= 1e-14 * np.max(np.abs(expect))
+    # each entry reaches its vertex's chord ends: more entries out than in
+    assert src.size > vertex.size
+    assert np.all(np.bincount(src, minlength=vertex.size) > 0)
+
+
 def _bent_crossing(shift: bool) -> tuple[RodSystem, SectionedLayer]:
     """Two bent rods crossing at 90 degrees, their centrelines 0.86 D0 apart, each bent
     away from the other (bend radius 1.2 D0), sections deformed at random."""

@@ -287,12 +287,16 @@ def test_the_level_in_a_rod_system_has_a_consistent_gradient_and_hessian() -> No
     check_derivatives(system, D0, rng, hess_tol=1e-4)
 
 
-def test_the_sections_turn_with_the_reference_twist_of_the_carried_frames() -> None:
+@pytest.mark.parametrize("bend_shift", [False, True])
+def test_the_sections_turn_with_the_reference_twist_of_the_carried_frames(
+        bend_shift: bool) -> None:
     # A bent rod (reference twists that move with its vertices) pressed by a crossing one:
     # the energy the system evaluates turns each section with the reference twist of the
     # frames carried to the trial positions, and its derivatives carry that twist's chain
     # rule (tightknot/contact/section_twist.py). Held at the accepted state's twist instead,
-    # the gradient misses it by far more than the tolerance below.
+    # the gradient misses it by far more than the tolerance below. With the bend shift the
+    # boundaries sit on the offset centreline and the twists stay the centreline's: the
+    # chain's columns are carried back through the shift's Jacobian.
     mat = Material(1.25e6, 0.5, 1160.0)
     b = RodBuilder(twist=True)
     s = np.linspace(-1.0, 1.0, 21)
@@ -305,7 +309,9 @@ def test_the_sections_turn_with_the_reference_twist_of_the_carried_frames() -> N
     state = State.initial(model)
     state.x += 1e-3 * D0 * rng.normal(size=state.x.shape)
     system = RodSystem(model, state, BoundaryConditions(model))
-    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=32))
+    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=32,
+                                                  bend_shift=bend_shift))
+    assert (layer.shift is not None and layer.shift.count > 0) == bend_shift
     system.add_term(layer)
     system.state.extra = 0.01 * D0 * rng.normal(size=layer.dof_count)
     system.accept(system.free_vector())  # the frames carried to the jittered positions
@@ -323,6 +329,38 @@ def test_the_sections_turn_with_the_reference_twist_of_the_carried_frames() -> N
     # the gradient exact (measured 2e-9 relative; 2e-3 with the chain's part left out), the
     # Hessian but for the frames' second derivatives, which are differences (measured 1.9e-4)
     check_derivatives(system, D0, rng, hess_tol=2e-3, random_sections=False)
+
+
+def test_the_twist_chain_keeps_and_grows_the_blocks_marks() -> None:
+    # The bend shift's pulled-back Hessian marks the blocks that couple positions only (no
+    # structural zeros in the matrix). The chain's entries keep those marks where they stay
+    # on positions and mark a block's section rows or columns where they reach them, else
+    # the system's matrix would drop them.
+    from tightknot.contact.section_twist import TwistChain
+    from tightknot.rods.term import BlockHessian
+
+    b = 5  # 3 positions and 2 section dofs per node
+    node_dofs = np.arange(3 * b).reshape(3, b)
+    chain = TwistChain(np.array([-1]), np.zeros((0, 3), dtype=np.int64),
+                       np.array([0, b, 2 * b]), node_dofs, 3 * b)
+    blocks = np.zeros((2, b, b))
+    blocks[:, :3, :3] = 1.0
+    hess = BlockHessian(node_dofs, np.array([[0, 1], [1, 0]]), blocks,
+                        np.array([False, False]), np.array([False, False]))
+    # (node 0 position, node 1 section), (node 1 position, node 0 position), (node 2
+    # position, node 2 position): a column grown, a marked block kept, a new block
+    rows = np.array([0, b + 1, 2 * b])
+    cols = np.array([b + 3, 2, 2 * b + 2])
+    out = chain._merged(hess, rows, cols, np.array([2.0, 3.0, 4.0]))
+    assert out.keys.tolist() == [[0, 1], [1, 0], [2, 2]]
+    assert out.full_rows.tolist() == [False, False, False]
+    assert out.full_cols.tolist() == [True, False, False]
+    assert out.blocks[0, 0, 3] == 2.0 and out.blocks[1, 1, 2] == 1.0 + 3.0
+    assert out.blocks[2, 0, 2] == 4.0
+    # an unmarked Hessian (the level without the shift) stays unmarked: every block whole
+    whole = chain._merged(BlockHessian(node_dofs, hess.keys, blocks), rows, cols,
+                          np.array([2.0, 3.0, 4.0]))
+    assert whole.full_rows is None and whole.full_cols is None
 
 
 def test_sections_thinned_by_the_rods_mean_stretch_have_an_exact_gradient() -> None:

@@ -223,6 +223,24 @@ class ShiftedCentreline:
         np.add.at(out, sh._next, np.einsum("nij,nj->ni", jac[sh._mid, 2], gm))
         return out
 
+    def pull_back_entries(self, vertex: np.ndarray, comp: np.ndarray, value: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Entries of vectors over x~ (``value`` at coordinate ``comp`` of vertex ``vertex``)
+        carried to x, J^T: (which input entry each output entry comes from, its vertex,
+        its coordinate, its value); entries that J's blocks make zero are left out."""
+        vertex = np.asarray(vertex, dtype=np.int64)
+        comp = np.asarray(comp, dtype=np.int64)
+        value = np.asarray(value, dtype=np.float64)
+        nbr, jac = self._jacobian()
+        # (J^T v)_(w, j) = sum over the x~_v that x_w moves of (d x~_(v, i) / d x_(w, j))
+        # v_(v, i): row i = ``comp`` of each of the entry's three blocks
+        src = np.repeat(np.arange(vertex.size), 9)
+        out_vertex = np.repeat(nbr[vertex], 3, axis=1).ravel()
+        out_comp = np.tile(np.arange(3), (vertex.size, 3)).ravel()
+        out_value = (jac[vertex, :, comp, :] * value[:, None, None]).ravel()
+        keep = (out_vertex >= 0) & (out_value != 0.0)
+        return src[keep], out_vertex[keep], out_comp[keep], out_value[keep]
+
     def _curvature_blocks(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The term sum_v g_v . d2 x~_v / dx2 as 3 x 3 blocks: node pairs (J, 2) and blocks
         (J, 3, 3), for the shifting vertices whose g_v is not zero."""

@@ -195,9 +195,10 @@ class TwistChain:
     def _merged(self, hess: BlockHessian, rows: np.ndarray, cols: np.ndarray,
                 vals: np.ndarray) -> BlockHessian:
         """``hess`` with the unique COO entries (rows, cols, vals) over the extended dofs
-        added, its node pairs grown by theirs (every block of the result whole: the
-        chain's blocks reach past a node's position now and then, and a system's kept
-        pattern is built again whenever a kept block grows)."""
+        added, its node pairs grown by theirs (every block of the result whole where
+        ``hess``'s are: the chain's blocks reach past a node's position now and then, and a
+        system's kept pattern is built again whenever a kept block grows; marked blocks,
+        the bend shift's, keep their marks, grown by the entries added)."""
         nodes = self.node_dofs.shape[0]
         b = hess.blocks.shape[1]
         old = hess.keys[:, 0] * nodes + hess.keys[:, 1]
@@ -218,6 +219,18 @@ class TwistChain:
         blocks[at_old] = hess.blocks
         # the entries are unique: a plain indexed add
         flat = blocks.reshape(-1)
-        flat[(at_new * b + self._dof_local[rows]) * b + self._dof_local[cols]] += vals
+        local_r, local_c = self._dof_local[rows], self._dof_local[cols]
+        flat[(at_new * b + local_r) * b + local_c] += vals
+        full_rows = full_cols = None
+        if hess.full_rows is not None or hess.full_cols is not None:
+            # marked blocks stay marked (rows and columns past a node's position that
+            # may be nonzero): the input's marks and those of the entries added
+            rows_in, cols_in = hess.masks()
+            full_rows = np.zeros(keys.size, dtype=bool)
+            full_cols = np.zeros(keys.size, dtype=bool)
+            full_rows[at_old] = rows_in
+            full_cols[at_old] = cols_in
+            full_rows[at_new[local_r >= 3]] = True
+            full_cols[at_new[local_c >= 3]] = True
         return BlockHessian(hess.node_dofs, np.stack([keys // nodes, keys % nodes], axis=1),
-                            blocks, None, None, hess.low_rank)
+                            blocks, full_rows, full_cols, hess.low_rank)

@@ -51,7 +51,7 @@ from tightknot.contact import sectioned_kernels as sk
 from tightknot.contact.layer import ContactLayer
 from tightknot.contact.rod_mean_radius import RodMeanRadius
 from tightknot.contact.section_modes import mode_stiffness
-from tightknot.contact.section_shift import MIN_CHORD, SectionShift
+from tightknot.contact.section_shift import MIN_CHORD, SectionShift, ShiftedCentreline
 from tightknot.contact.section_twist import (
     TwistChain,
     TwistParts,
@@ -324,13 +324,15 @@ class SectionedLayer(ContactLayer):
         pos = m.vertex_dof.astype(np.int64)[:, None] + np.arange(3)
         sec = np.where(offset[:, None] >= 0, m.dof_count + offset[:, None] + np.arange(k), -1)
         self._node_dofs = np.concatenate([pos, sec], axis=1)
-        # The end twists' chain rule (the joint after each deformable edge; none with the
-        # bend shift, whose boundaries are carried in the accepted frames' twist)
+        # each position dof's vertex (-1: a twist dof)
+        self._dof_vertex = np.full(m.dof_count, -1, dtype=np.int64)
+        self._dof_vertex[pos.ravel()] = np.repeat(np.arange(nodes), 3)
+        # The end twists' chain rule (the joint after each deformable edge): the twists are
+        # the centreline's, with or without the bend shift
         twist_joint = np.where(self.edge_rigid, -1, nxt)
-        #: The chain rule through the end twists (None: they are held within an iteration).
-        self.twist_chain = (TwistChain(twist_joint, m.joint_vertex, m.vertex_dof,
-                                       self._node_dofs, m.dof_count + self.dof_count)
-                            if self.shift is None else None)
+        #: The chain rule through the end twists.
+        self.twist_chain = TwistChain(twist_joint, m.joint_vertex, m.vertex_dof,
+                                      self._node_dofs, m.dof_count + self.dof_count)
         # The node pairs the section energy always couples (each deformable edge's ends).
         se = ev[self._section_edges]
         pairs = np.concatenate([se, se[:, ::-1], se[:, [0, 0]], se[:, [1, 1]]])
@@ -848,14 +850,33 @@ class SectionedLayer(ContactLayer):
                 self._add_stretch_blocks(hess, geo, big_g)
                 hess.low_rank = self._rod_mean_low_rank(geo, wx, wp_act, data, slots,
                                                         keys.size, act_pairs, dofs)
-        parts = (self._contact_twist_parts(act_pairs, extra, out, dofs)
-                 if twist and self.twist_chain is not None else None)
+        parts = self._contact_twist_parts(act_pairs, extra, out, dofs) if twist else None
         if shifted is not None:
             # derivatives over the offset centreline carried to the centreline
             if hess is not None:
                 hess = shifted.pull_back_hessian(hess, g_x)
             g_x = shifted.pull_back_gradient(g_x)
+            if parts is not None:
+                parts = self._shifted_twist_parts(parts, shifted)
         return energy, g_x, g_c, hess, parts
+
+    def _shifted_twist_parts(self, parts: TwistParts, shifted: ShiftedCentreline
+                             ) -> TwistParts:
+        """The contact's twist parts with their columns C_e over the offset centreline's
+        positions carried to the centreline's (J^T C_e; the end twists themselves are the
+        centreline's, so their first derivatives and M_ef stay)."""
+        m = self.model
+        col = parts.col_dof
+        is_pos = col < m.dof_count  # the passes' model dofs are positions only
+        vertex = self._dof_vertex[col[is_pos]]
+        comp = col[is_pos] - m.vertex_dof.astype(np.int64)[vertex]
+        src, w, c, val = shifted.pull_back_entries(vertex, comp, parts.col_value[is_pos])
+        pos_dof = m.vertex_dof.astype(np.int64)[w] + c
+        return TwistParts(parts.first,
+                          np.concatenate([parts.col_edge[~is_pos], parts.col_edge[is_pos][src]]),
+                          np.concatenate([col[~is_pos], pos_dof]),
+                          np.concatenate([parts.col_value[~is_pos], val]),
+                          parts.pair_edge, parts.pair_value)
 
     def _contact_twist_parts(self, act_pairs: np.ndarray, extra: np.ndarray,
                              out: dict[str, np.ndarray], dofs: np.ndarray) -> TwistParts:
@@ -1044,11 +1065,11 @@ class SectionedLayer(ContactLayer):
         Hessian in node blocks over the extended dofs (rods/term.py). ``twist``: the
         reference twist [rad] of the frames carried to ``x`` (the system's trial frames),
         which the sections then turn with, its chain rule in the derivatives
-        (:mod:`tightknot.contact.section_twist`; not with the bend shift, whose sections
-        keep the accepted frames' twist); None: the accepted ``m_ref``, held."""
+        (:mod:`tightknot.contact.section_twist`; with the bend shift too: the twists are
+        the centreline's); None: the accepted ``m_ref``, held."""
         extra = np.asarray(extra, dtype=np.float64)
         rest = np.asarray(rest, dtype=np.float64)
-        chain = twist is not None and self.twist_chain is not None
+        chain = twist is not None
         if chain:
             frames = (frames[0], frames[1], np.asarray(twist, dtype=np.float64))
         derivatives = want_grad or want_hess
