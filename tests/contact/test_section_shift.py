@@ -64,6 +64,24 @@ def test_a_circle_shifts_its_sections_toward_its_centre(closed: bool) -> None:
         assert np.allclose(radial[least:m], expect, rtol=0.01)
 
 
+def test_a_fraction_of_the_shift_moves_the_sections_that_fraction() -> None:
+    # section_finish's homotopy applies a fraction of the shift: the offset scales with it
+    # (its Jacobian with it: the pull-back test below holds at any scale), the bend it
+    # reports does not.
+    model = _model([_circle(3.0 * D0, 61, False)])
+    shift = SectionShift(model, chord=1.0)
+    x, rest = model.vertex_initial_position, model.edge_rest_length
+    whole = shift.at(x, rest).x - x
+    kappa_r = shift.max_kappa_r(x, rest)
+    shift.set_scale(0.25)
+    assert np.allclose(shift.at(x, rest).x - x, 0.25 * whole, rtol=0.0,
+                       atol=1e-12 * np.abs(whole).max())
+    assert shift.max_kappa_r(x, rest) == pytest.approx(kappa_r, rel=1e-12)
+    for bad in (0.0, -0.5, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="scale"):
+            shift.set_scale(bad)
+
+
 def test_a_straight_rod_does_not_shift() -> None:
     z = np.linspace(0.0, 4.0 * D0, 30)
     model = _model([np.c_[np.zeros(30), np.zeros(30), z]])

@@ -194,6 +194,50 @@ def test_sections_thinner_than_the_fem_judged_are_said(sectioned_run) -> None:
     assert any("A/A0 = 0.43, below the 0.693" in w for w in out["warnings"])
 
 
+def test_a_failed_shifted_section_solve_grows_the_shift_from_its_start(monkeypatch) -> None:
+    """With the bend shift, where Newton fails from the round sections (the shift moves a
+    tight knot's inner sides into their partners at once: the 125 mm open knot's first
+    sectioned residual 2.7e5, docs/sectioned_level.md), section_finish solves again from
+    its start with the shift grown from a quarter, and reaches the equilibrium the direct
+    solve finds; the layer keeps its whole shift."""
+    import tightknot.loading.tie as tie_module
+
+    def scene_of():
+        return closed_trefoil(16.37, nodes=40, contact=SectionSettings(bend_shift=True))
+
+    ref = tie(scene_of(), tighten_steps=20, section_path="final").run()
+    assert ref.converged, ref.failure
+    real = tie_module.static_solve
+    scene = scene_of()
+    seen: list[tuple[float, float]] = []
+
+    def lost(system, newton_options, *args, **kwargs):
+        seen.append((scene.contact.shift.scale, scene.contact.penalty_scale))
+        if newton_options.max_iterations == tie_module.DIRECT_SECTION_ITERATIONS \
+                and len(seen) == 1:
+            # an end far from the start, as a leap into another basin leaves it
+            system.state.x = system.state.x * 1.01
+            r, iterations, _ = yield from real(system, dataclasses.replace(
+                newton_options, max_iterations=1), None, 0)
+            return dataclasses.replace(r, converged=False, reason="max_iterations"), 1, "lost"
+        return (yield from real(system, newton_options, *args, **kwargs))
+
+    monkeypatch.setattr(tie_module, "static_solve", lost)
+    res = tie(scene, tighten_steps=20, section_path="final").run()
+    assert res.converged, res.failure
+    assert res.knot_types[-1] == "3_1"
+    # the direct solve with the whole shift, then the shift's homotopy at the full penalty
+    assert seen == [(1.0, 1.0)] + [(f, 1.0) for f in tie_module.SHIFT_HOMOTOPY]
+    assert scene.contact.shift.scale == 1.0
+    # the same knot (as below: a closed knot's equilibria differ by ~1e-4 in length)
+    x, x_ref = res.system.state.x, ref.system.state.x
+
+    def length(y):
+        return float(np.linalg.norm(np.roll(y, -1, axis=0) - y, axis=1).sum())
+
+    assert length(x) == pytest.approx(length(x_ref), rel=1e-4)
+
+
 @pytest.mark.parametrize("homotopy_fails", [False, True])
 def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch,
                                                              homotopy_fails: bool) -> None:

@@ -130,6 +130,15 @@ class SectionShift:
         #: nu R^2 of each shifting vertex [m^2] and its rest radius R [m].
         self.nu_r2 = np.concatenate(nu_r2) if nu_r2 else np.zeros(0)
         self.radius = np.concatenate(radius) if radius else np.zeros(0)
+        #: The fraction of the shift applied, in (0, 1]: below 1 only on a continuation
+        #: path toward the full shift (:func:`tightknot.loading.tie.section_finish`).
+        self.scale = 1.0
+
+    def set_scale(self, scale: float) -> None:
+        """Apply the fraction ``scale`` in (0, 1] of the shift."""
+        if not (math.isfinite(scale) and 0.0 < scale <= 1.0):
+            raise ValueError(f"the bend shift's scale must be in (0, 1], got {scale!r}")
+        self.scale = float(scale)
 
     @property
     def count(self) -> int:
@@ -142,8 +151,8 @@ class SectionShift:
         if self.count == 0:
             return 0.0
         sh = self.at(x, rest)
-        # |s_v| = c |t_1 - t_0| = (nu R^2 / 2) kappa
-        size = sh.c * np.linalg.norm(sh.t1 - sh.t0, axis=1)
+        # |s_v| = c |t_1 - t_0| = scale (nu R^2 / 2) kappa
+        size = sh.c * np.linalg.norm(sh.t1 - sh.t0, axis=1) / self.scale
         return float(np.max(2.0 * size * self.radius / self.nu_r2))
 
     def at(self, x: np.ndarray, rest: np.ndarray) -> ShiftedCentreline:
@@ -161,7 +170,7 @@ class SectionShift:
         # rest lengths L_bar
         arc = (np.sum(rest[self._before] * self._weight_before, axis=1)
                + np.sum(rest[self._after] * self._weight_after, axis=1))
-        c = self.nu_r2 / arc
+        c = self.scale * self.nu_r2 / arc
         shifted = x.copy()
         shifted[self._mid] += c[:, None] * (t1 - t0)
         return ShiftedCentreline(self, shifted, c, t0, t1, l0, l1)

@@ -403,6 +403,14 @@ class SectionedLayer(ContactLayer):
         self.penalty_scale = float(scale)
         self._energy_only = None
 
+    def set_shift_scale(self, scale: float) -> None:
+        """Apply the fraction ``scale`` in (0, 1] of the bend shift (a continuation path's
+        stage, :func:`tightknot.loading.tie.section_finish`); no effect without the
+        shift."""
+        if self.shift is not None:
+            self.shift.set_scale(scale)
+            self._energy_only = None
+
     # -- the section field -----------------------------------------------------------------
     def end_twist(self, m_ref: np.ndarray) -> np.ndarray:
         """Per edge, the reference twist [rad] from its frame to the frame its second

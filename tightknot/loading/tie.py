@@ -257,28 +257,49 @@ def system_at(scene: KnotScene, done: RodSystem, history: bool = False) -> RodSy
 DIRECT_SECTION_ITERATIONS = 150
 #: The penalty factors of :func:`section_finish`'s homotopy, the last the level's own.
 PENALTY_HOMOTOPY = (0.125, 0.25, 0.5, 1.0)
+#: The fractions of the bend shift in :func:`section_finish`'s shift homotopy, the last
+#: the whole shift.
+SHIFT_HOMOTOPY = (0.25, 0.5, 0.75, 1.0)
 
 
-def _penalty_homotopy(system: RodSystem, layer: SectionedLayer, steps: ContinuationOptions
-                      ) -> Coroutine[tuple[NewtonResult, int, str]]:
-    """Static solves of ``system`` at the penalty factors :data:`PENALTY_HOMOTOPY` of
-    ``layer`` in turn, each from the last one's equilibrium (Newton, then proximal steps);
-    the last solve's result (the first failed one's where one fails), the iterations of
-    all and how it ended. The layer's own penalty is restored."""
+def _homotopy(system: RodSystem, factors: tuple[float, ...], apply: Callable[[float], None],
+              what: str, steps: ContinuationOptions
+              ) -> Coroutine[tuple[NewtonResult, int, str]]:
+    """Static solves of ``system`` at the ``factors`` of a parameter (set by
+    ``apply``, ``what`` it is) in turn, each from the last one's equilibrium (Newton, then
+    proximal steps); the last solve's result (the first failed one's where one fails), the
+    iterations of all and how it ended. The parameter's own value (factor 1) is
+    restored."""
     iters = 0
     try:
-        for f in PENALTY_HOMOTOPY:
-            layer.set_penalty_scale(f)
+        for f in factors:
+            apply(f)
             r, it, prox = yield from static_solve(
                 system, dataclasses.replace(steps.newton, max_iterations=400),
                 steps.proximal_dt, steps.proximal_steps, steps.newton)
             iters += it
             if not r.converged:
-                return r, iters, (f"at {f:g} of the penalty, Newton {r.reason}"
+                return r, iters, (f"at {f:g} of the {what}, Newton {r.reason}"
                                   + (f", proximal steps {prox}" if prox else ""))
     finally:
-        layer.set_penalty_scale(1.0)
+        apply(1.0)
     return r, iters, "converged"
+
+
+def _penalty_homotopy(system: RodSystem, layer: SectionedLayer, steps: ContinuationOptions
+                      ) -> Coroutine[tuple[NewtonResult, int, str]]:
+    """:func:`_homotopy` over the penalty factors :data:`PENALTY_HOMOTOPY` of
+    ``layer``."""
+    return (yield from _homotopy(system, PENALTY_HOMOTOPY, layer.set_penalty_scale,
+                                 "penalty", steps))
+
+
+def _shift_homotopy(system: RodSystem, layer: SectionedLayer, steps: ContinuationOptions
+                    ) -> Coroutine[tuple[NewtonResult, int, str]]:
+    """:func:`_homotopy` over the fractions :data:`SHIFT_HOMOTOPY` of ``layer``'s bend
+    shift."""
+    return (yield from _homotopy(system, SHIFT_HOMOTOPY, layer.set_shift_scale,
+                                 "bend shift", steps))
 
 
 def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
@@ -288,7 +309,8 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     """The equilibrium of ``scene`` at its own contact level under the last load of
     ``res``, a converged load path of the same rod at another level (:func:`path_scene`):
     one static solve from its equilibrium, round sections added (where Newton fails
-    within :data:`DIRECT_SECTION_ITERATIONS`, the same start again with the penalty grown
+    within :data:`DIRECT_SECTION_ITERATIONS`, the same start again with the bend shift
+    grown by :func:`_shift_homotopy` where the level has one, then with the penalty grown
     by :func:`_penalty_homotopy`, then proximal steps alone), the knot type checked,
     ``hook("section", ...)`` called with it. With
     ``end_held`` the pulling force is the held end's reaction at the new equilibrium.
@@ -307,6 +329,15 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     retry = not r.converged and system.violation is None and r.reason != "passed_through"
     tried = [f"Newton {r.reason}"]
     layer = scene.contact
+    if retry and isinstance(layer, SectionedLayer) and layer.shift is not None:
+        # The bend shift moves a tight knot's inner sides into their partners all at once
+        # (the round sections' start is the knot without it): the shift is grown from a
+        # quarter, each solve starting from the last one's equilibrium.
+        system.state = start.copy()
+        r, again, stopped = yield from _shift_homotopy(system, layer, steps)
+        iters += again
+        tried.append(f"the bend shift grown from the start: {stopped}")
+        retry = not r.converged and system.violation is None and r.reason != "passed_through"
     if retry and isinstance(layer, SectionedLayer):
         # From round sections at a tight knot's contacts, Newton can leap into a far basin
         # (single edges necking under their sections' thinning, docs/sectioned_level.md).
