@@ -194,10 +194,36 @@ def test_sections_thinner_than_the_fem_judged_are_said(sectioned_run) -> None:
     assert any("A/A0 = 0.43, below the 0.693" in w for w in out["warnings"])
 
 
+def _lost_solve(real, system, newton_options):
+    """A failed solve that ends far from its start, as a leap into another basin leaves
+    it: one Newton iteration from the start scaled by 1.01, reported unconverged."""
+    system.state.x = system.state.x * 1.01
+    r, _, _ = yield from real(system, dataclasses.replace(newton_options, max_iterations=1),
+                              None, 0)
+    return dataclasses.replace(r, converged=False, reason="max_iterations"), 1, "lost"
+
+
+def _tied_final_with(monkeypatch, scene, solve):
+    """``scene`` tied on the ``final`` path with the tie module's static solves replaced
+    by ``solve``: converged, a trefoil."""
+    import tightknot.loading.tie as tie_module
+
+    monkeypatch.setattr(tie_module, "static_solve", solve)
+    res = tie(scene, tighten_steps=20, section_path="final").run()
+    assert res.converged, res.failure
+    assert res.knot_types[-1] == "3_1"
+    return res
+
+
+def _closed_length(y: np.ndarray) -> float:
+    """A closed centreline's length [m]."""
+    return float(np.linalg.norm(np.roll(y, -1, axis=0) - y, axis=1).sum())
+
+
 def test_a_failed_shifted_section_solve_grows_the_shift_from_its_start(monkeypatch) -> None:
     """With the bend shift, where Newton fails from the round sections (the shift moves a
-    tight knot's inner sides into their partners at once: the 125 mm open knot's first
-    sectioned residual 2.7e5, docs/sectioned_level.md), section_finish solves again from
+    tight knot's inner sides toward their partners at once: the 125 mm open knot's first
+    shifted solve failed, docs/sectioned_level.md), section_finish solves again from
     its start with the shift grown from a quarter, and reaches the equilibrium the direct
     solve finds; the layer keeps its whole shift."""
     import tightknot.loading.tie as tie_module
@@ -215,27 +241,16 @@ def test_a_failed_shifted_section_solve_grows_the_shift_from_its_start(monkeypat
         seen.append((scene.contact.shift.scale, scene.contact.penalty_scale))
         if newton_options.max_iterations == tie_module.DIRECT_SECTION_ITERATIONS \
                 and len(seen) == 1:
-            # an end far from the start, as a leap into another basin leaves it
-            system.state.x = system.state.x * 1.01
-            r, iterations, _ = yield from real(system, dataclasses.replace(
-                newton_options, max_iterations=1), None, 0)
-            return dataclasses.replace(r, converged=False, reason="max_iterations"), 1, "lost"
+            return (yield from _lost_solve(real, system, newton_options))
         return (yield from real(system, newton_options, *args, **kwargs))
 
-    monkeypatch.setattr(tie_module, "static_solve", lost)
-    res = tie(scene, tighten_steps=20, section_path="final").run()
-    assert res.converged, res.failure
-    assert res.knot_types[-1] == "3_1"
+    res = _tied_final_with(monkeypatch, scene, lost)
     # the direct solve with the whole shift, then the shift's homotopy at the full penalty
     assert seen == [(1.0, 1.0)] + [(f, 1.0) for f in tie_module.SHIFT_HOMOTOPY]
     assert scene.contact.shift.scale == 1.0
     # the same knot (as below: a closed knot's equilibria differ by ~1e-4 in length)
-    x, x_ref = res.system.state.x, ref.system.state.x
-
-    def length(y):
-        return float(np.linalg.norm(np.roll(y, -1, axis=0) - y, axis=1).sum())
-
-    assert length(x) == pytest.approx(length(x_ref), rel=1e-4)
+    assert _closed_length(res.system.state.x) == pytest.approx(
+        _closed_length(ref.system.state.x), rel=1e-4)
 
 
 @pytest.mark.parametrize("homotopy_fails", [False, True])
@@ -261,17 +276,10 @@ def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch,
         direct = (newton_options.max_iterations == tie_module.DIRECT_SECTION_ITERATIONS
                   and len(seen) == 1)
         if direct or (homotopy_fails and scale < 1.0 and len(seen) == 2):
-            # an end far from the start, as a leap into another basin leaves it
-            system.state.x = system.state.x * 1.01
-            r, iterations, _ = yield from real(system, dataclasses.replace(
-                newton_options, max_iterations=1), None, 0)
-            return dataclasses.replace(r, converged=False, reason="max_iterations"), 1, "lost"
+            return (yield from _lost_solve(real, system, newton_options))
         return (yield from real(system, newton_options, *args, **kwargs))
 
-    monkeypatch.setattr(tie_module, "static_solve", lost)
-    res = tie(scene, tighten_steps=20, section_path="final").run()
-    assert res.converged, res.failure
-    assert res.knot_types[-1] == "3_1"
+    res = _tied_final_with(monkeypatch, scene, lost)
     # the direct solve at the full penalty, then the homotopy's (only its first where it
     # is made to fail; the proximal steps then run at the full penalty)
     assert seen[0] == 1.0
@@ -279,9 +287,5 @@ def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch,
     assert scene.contact.penalty_scale == 1.0
     # the same knot: a closed knot's equilibria along its slide differ by ~1e-4 D0 in
     # stretch (this file's final-versus-full test); its length to 1e-4
-    x, x_ref = res.system.state.x, ref.system.state.x
-
-    def length(y):
-        return float(np.linalg.norm(np.roll(y, -1, axis=0) - y, axis=1).sum())
-
-    assert length(x) == pytest.approx(length(x_ref), rel=1e-4)
+    assert _closed_length(res.system.state.x) == pytest.approx(
+        _closed_length(ref.system.state.x), rel=1e-4)
