@@ -84,6 +84,37 @@ def test_steps_below_the_roundoff_stop_as_stalled() -> None:
     assert res.reason == "stalled" and res.iterations == 10
 
 
+class _Sliding(_Blocked):
+    """E = -u_0 + |u_1.. - 1|^2 / 2: every Newton step lowers the energy by 1 (down a
+    slope without end, as a solve that leaps toward another basin) while the residual
+    stays 1."""
+
+    def evaluate(self, u, want_grad=True, want_hess=True):
+        import scipy.sparse as sp
+
+        r = u - self.target
+        r[0] = -1.0
+        e = -float(u[0]) + 0.5 * float(r[1:] @ r[1:])
+        return e, r, sp.identity(u.size, format="csc")
+
+    def max_step(self, u, du):
+        return 1.0
+
+
+@pytest.mark.parametrize("on_residual", [False, True])
+def test_a_falling_energy_counts_as_progress_unless_the_residual_alone_is_judged(
+        on_residual: bool) -> None:
+    # section_finish's first solve judges its residual alone: its fallback (a homotopy)
+    # starts again from the start, so a descent that does not bring the residual down is
+    # given up after the window instead of the whole budget.
+    res = newton(_Sliding(), np.zeros(3), NewtonOptions(
+        max_iterations=120, stall_iterations=40, stall_on_residual=on_residual)).run()
+    assert not res.converged
+    assert (res.reason, res.iterations) == (("stalled", 40) if on_residual
+                                            else ("max_iterations", 120))
+    assert res.energy == pytest.approx(-res.iterations, rel=1e-12)
+
+
 def test_stall_test_can_be_turned_off() -> None:
     res = newton(_Blocked(), np.zeros(3), NewtonOptions(
         max_iterations=60, step_tol=1e-300, stall_iterations=0, blind_iterations=0)).run()

@@ -324,7 +324,8 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     # A first Newton solve at the full penalty, on a budget of twice the most iterations
     # it took where it converged (27 to 75 on the study's knots, docs/sectioned_level.md).
     r, iters, _ = yield from static_solve(
-        system, dataclasses.replace(steps.newton, max_iterations=DIRECT_SECTION_ITERATIONS),
+        system, dataclasses.replace(steps.newton, max_iterations=DIRECT_SECTION_ITERATIONS,
+                                    stall_on_residual=True),
         None, 0)
     retry = not r.converged and system.violation is None and r.reason != "passed_through"
     tried = [f"Newton {r.reason}"]

@@ -63,6 +63,10 @@ class NewtonOptions:
         stall_roundoffs: energy decrease that counts as progress, in units of the
             problem's energy round-off (a thousand: well above noise, yet far below the
             decrease of any iteration that moves the rod measurably).
+        stall_on_residual: the no-progress test judges the residual alone, an energy that
+            still falls counting as no progress (a solve with a fallback, for which a
+            descent that does not bring the residual down leads into another basin, e.g.
+            :func:`tightknot.loading.tie.section_finish`'s first solve).
         blind_iterations: the solve stops as "stalled" after this many iterations in a
             row whose predicted decrease was below the energy's round-off (the energy can
             then not judge the step) while the residual did not fall below
@@ -81,6 +85,7 @@ class NewtonOptions:
     stall_iterations: int = 50
     stall_factor: float = 0.5
     stall_roundoffs: float = 1e3
+    stall_on_residual: bool = False
     blind_iterations: int = 10
 
     def __post_init__(self) -> None:
@@ -249,7 +254,8 @@ def _stalled(best: list[float], energies: list[float], opt: NewtonOptions,
         return False
     if best[-1] < opt.stall_factor * best[-1 - w]:
         return False
-    return energies[-1 - w] - energies[-1] <= opt.stall_roundoffs * roundoff
+    return (opt.stall_on_residual
+            or energies[-1 - w] - energies[-1] <= opt.stall_roundoffs * roundoff)
 
 
 def _raised(mu: float, opt: NewtonOptions, indefinite: bool) -> float:
