@@ -26,7 +26,7 @@ dx2.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -195,10 +195,18 @@ class ShiftedCentreline:
     t1: np.ndarray
     l0: np.ndarray
     l1: np.ndarray
+    _jac: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False, compare=False)
 
     def _jacobian(self) -> tuple[np.ndarray, np.ndarray]:
         """Per vertex, its three Jacobian neighbours (x_{v-m}, x_v, x_{v+m}; -1 where
-        none) and the 3 x 3 blocks d x~_v / d x_neighbour (symmetric)."""
+        none) and the 3 x 3 blocks d x~_v / d x_neighbour (symmetric); built once, for the
+        gradient's, the Hessian's and the twist columns' pull-backs of one evaluation."""
+        if self._jac is None:
+            self._jac = self._build_jacobian()
+        return self._jac
+
+    def _build_jacobian(self) -> tuple[np.ndarray, np.ndarray]:
+        """The pieces :meth:`_jacobian` returns."""
         sh = self.shift
         nv = self.x.shape[0]
         nbr = np.full((nv, 3), -1, dtype=np.int64)

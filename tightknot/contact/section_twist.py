@@ -144,14 +144,14 @@ class TwistChain:
         pos = np.asarray(vertex_dof, dtype=np.int64)[self.joint_vertex][:, :, None] + np.arange(3)
         #: The extended dofs of each twist edge's joint positions (R, 9).
         self.joint_dofs = pos.reshape(-1, 9)
-        # extended dof -> (node, local index in its block)
-        self._dof_node = np.full(self.ext_count, -1, dtype=np.int64)
-        self._dof_local = np.full(self.ext_count, -1, dtype=np.int64)
+        #: Each extended dof's node and its index within the node's block (-1: none).
+        self.dof_node = np.full(self.ext_count, -1, dtype=np.int64)
+        self.dof_local = np.full(self.ext_count, -1, dtype=np.int64)
         nodes, width = node_dofs.shape
         has = node_dofs >= 0
-        self._dof_node[node_dofs[has]] = np.repeat(np.arange(nodes), width).reshape(
+        self.dof_node[node_dofs[has]] = np.repeat(np.arange(nodes), width).reshape(
             nodes, width)[has]
-        self._dof_local[node_dofs[has]] = np.tile(np.arange(width), nodes).reshape(
+        self.dof_local[node_dofs[has]] = np.tile(np.arange(width), nodes).reshape(
             nodes, width)[has]
 
     def apply(self, x: np.ndarray, parts: TwistParts, g_x: np.ndarray,
@@ -202,7 +202,7 @@ class TwistChain:
         nodes = self.node_dofs.shape[0]
         b = hess.blocks.shape[1]
         old = hess.keys[:, 0] * nodes + hess.keys[:, 1]
-        new = self._dof_node[rows] * nodes + self._dof_node[cols]
+        new = self.dof_node[rows] * nodes + self.dof_node[cols]
         if nodes * nodes <= DENSE_KEYS:
             # node pairs marked in a dense table: sorted and unique without a sort
             mark = np.zeros(nodes * nodes, dtype=bool)
@@ -219,7 +219,7 @@ class TwistChain:
         blocks[at_old] = hess.blocks
         # the entries are unique: a plain indexed add
         flat = blocks.reshape(-1)
-        local_r, local_c = self._dof_local[rows], self._dof_local[cols]
+        local_r, local_c = self.dof_local[rows], self.dof_local[cols]
         flat[(at_new * b + local_r) * b + local_c] += vals
         full_rows = full_cols = None
         if hess.full_rows is not None or hess.full_cols is not None:

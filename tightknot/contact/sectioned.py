@@ -324,9 +324,6 @@ class SectionedLayer(ContactLayer):
         pos = m.vertex_dof.astype(np.int64)[:, None] + np.arange(3)
         sec = np.where(offset[:, None] >= 0, m.dof_count + offset[:, None] + np.arange(k), -1)
         self._node_dofs = np.concatenate([pos, sec], axis=1)
-        # each position dof's vertex (-1: a twist dof)
-        self._dof_vertex = np.full(m.dof_count, -1, dtype=np.int64)
-        self._dof_vertex[pos.ravel()] = np.repeat(np.arange(nodes), 3)
         # The end twists' chain rule (the joint after each deformable edge): the twists are
         # the centreline's, with or without the bend shift
         twist_joint = np.where(self.edge_rigid, -1, nxt)
@@ -873,13 +870,12 @@ class SectionedLayer(ContactLayer):
         """The contact's twist parts with their columns C_e over the offset centreline's
         positions carried to the centreline's (J^T C_e; the end twists themselves are the
         centreline's, so their first derivatives and M_ef stay)."""
-        m = self.model
         col = parts.col_dof
-        is_pos = col < m.dof_count  # the passes' model dofs are positions only
-        vertex = self._dof_vertex[col[is_pos]]
-        comp = col[is_pos] - m.vertex_dof.astype(np.int64)[vertex]
-        src, w, c, val = shifted.pull_back_entries(vertex, comp, parts.col_value[is_pos])
-        pos_dof = m.vertex_dof.astype(np.int64)[w] + c
+        local = self.twist_chain.dof_local[col]
+        is_pos = local < 3  # a node's first three dofs are its position
+        src, w, c, val = shifted.pull_back_entries(self.twist_chain.dof_node[col[is_pos]],
+                                                   local[is_pos], parts.col_value[is_pos])
+        pos_dof = self._node_dofs[w, c]
         return TwistParts(parts.first,
                           np.concatenate([parts.col_edge[~is_pos], parts.col_edge[is_pos][src]]),
                           np.concatenate([col[~is_pos], pos_dof]),

@@ -286,20 +286,10 @@ def _homotopy(system: RodSystem, factors: tuple[float, ...], apply: Callable[[fl
     return r, iters, "converged"
 
 
-def _penalty_homotopy(system: RodSystem, layer: SectionedLayer, steps: ContinuationOptions
-                      ) -> Coroutine[tuple[NewtonResult, int, str]]:
-    """:func:`_homotopy` over the penalty factors :data:`PENALTY_HOMOTOPY` of
-    ``layer``."""
-    return (yield from _homotopy(system, PENALTY_HOMOTOPY, layer.set_penalty_scale,
-                                 "penalty", steps))
-
-
-def _shift_homotopy(system: RodSystem, layer: SectionedLayer, steps: ContinuationOptions
-                    ) -> Coroutine[tuple[NewtonResult, int, str]]:
-    """:func:`_homotopy` over the fractions :data:`SHIFT_HOMOTOPY` of ``layer``'s bend
-    shift."""
-    return (yield from _homotopy(system, SHIFT_HOMOTOPY, layer.set_shift_scale,
-                                 "bend shift", steps))
+def _retriable(r: NewtonResult, system: RodSystem) -> bool:
+    """A failed solve that a solve from its start along another path may mend (not a
+    step that passed through, which the system's check reports)."""
+    return not r.converged and system.violation is None and r.reason != "passed_through"
 
 
 def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
@@ -310,8 +300,9 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     ``res``, a converged load path of the same rod at another level (:func:`path_scene`):
     one static solve from its equilibrium, round sections added (where Newton fails
     within :data:`DIRECT_SECTION_ITERATIONS`, the same start again with the bend shift
-    grown by :func:`_shift_homotopy` where the level has one, then with the penalty grown
-    by :func:`_penalty_homotopy`, then proximal steps alone), the knot type checked,
+    grown by :data:`SHIFT_HOMOTOPY` where the level has one, then with the penalty grown
+    by :data:`PENALTY_HOMOTOPY` (:func:`_homotopy`), then proximal steps alone), the knot
+    type checked,
     ``hook("section", ...)`` called with it. With
     ``end_held`` the pulling force is the held end's reaction at the new equilibrium.
     On failure the result's state is the load path's equilibrium (round sections), the
@@ -327,28 +318,29 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
         system, dataclasses.replace(steps.newton, max_iterations=DIRECT_SECTION_ITERATIONS,
                                     stall_on_residual=True),
         None, 0)
-    retry = not r.converged and system.violation is None and r.reason != "passed_through"
+    retry = _retriable(r, system)
     tried = [f"Newton {r.reason}"]
     layer = scene.contact
-    if retry and isinstance(layer, SectionedLayer) and layer.shift is not None:
-        # The bend shift moves a tight knot's inner sides into their partners all at once
-        # (the round sections' start is the knot without it): the shift is grown from a
-        # quarter, each solve starting from the last one's equilibrium.
-        system.state = start.copy()
-        r, again, stopped = yield from _shift_homotopy(system, layer, steps)
-        iters += again
-        tried.append(f"the bend shift grown from the start: {stopped}")
-        retry = not r.converged and system.violation is None and r.reason != "passed_through"
-    if retry and isinstance(layer, SectionedLayer):
+    homotopies = []
+    if isinstance(layer, SectionedLayer):
+        if layer.shift is not None:
+            # The bend shift moves a tight knot's inner sides into their partners all at
+            # once (the round sections' start is the knot without it): it is grown from a
+            # quarter.
+            homotopies.append((SHIFT_HOMOTOPY, layer.set_shift_scale, "bend shift"))
         # From round sections at a tight knot's contacts, Newton can leap into a far basin
-        # (single edges necking under their sections' thinning, docs/sectioned_level.md).
-        # The penalty is then grown from an eighth of its value by doubling, each solve
-        # starting from the equilibrium of the softer one.
+        # (single edges necking under their sections' thinning, docs/sectioned_level.md):
+        # the penalty is grown from an eighth of its value by doubling.
+        homotopies.append((PENALTY_HOMOTOPY, layer.set_penalty_scale, "penalty"))
+    for factors, apply, what in homotopies:
+        if not retry:
+            break
+        # every homotopy from the same start, its solves each from the last equilibrium
         system.state = start.copy()
-        r, again, stopped = yield from _penalty_homotopy(system, layer, steps)
+        r, again, stopped = yield from _homotopy(system, factors, apply, what, steps)
         iters += again
-        tried.append(f"the penalty grown from the start: {stopped}")
-        retry = not r.converged and system.violation is None and r.reason != "passed_through"
+        tried.append(f"the {what} grown from the start: {stopped}")
+        retry = _retriable(r, system)
     if retry:
         # Proximal steps alone from the same start only ever descend.
         system.state = start.copy()
