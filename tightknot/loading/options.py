@@ -287,7 +287,8 @@ class LoadPath:
                               "again there), full (every load step with the sections: a "
                               "pulled knot's equilibrium can depend on its path), pull "
                               "(relax and tighten at the compliant level, then the sections "
-                              "added and the knot pulled with them) or auto (final for a "
+                              "added and the knot pulled with them; final where the pull "
+                              "loosens the knot) or auto (final for a "
                               "closed knot, pull for an open one)")
     # A setting of the sectioned level beside its path, not a scene parameter: sweeps run
     # without it, so their case ids stay (tightknot/sweep/cases.py, NOT_CASE_KEYS).

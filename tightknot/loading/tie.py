@@ -165,7 +165,9 @@ def tie(
             at the compliant level and solves the sections' equilibrium under its last
             load (:func:`section_finish`); "full" runs every step with the sections;
             "pull" relaxes and tightens at the compliant level, solves the sections'
-            equilibrium there and pulls with them ("final" where nothing is pulled);
+            equilibrium there and pulls with them ("final" where nothing is pulled or
+            where the pull loosens the knot: a force below the tightened knot's, an end
+            distance shorter than its own);
             "auto": "final" for a closed knot, "pull" for an open one.
     """
     if scene.contact is None:
@@ -222,7 +224,10 @@ def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> K
     way there picks one: sections added only under the final force ("final") can settle
     on the other, so "auto" adds them at the tightened knot and pulls with them ("pull"),
     which reaches the knot of a path with the sections all the way ("full")
-    (docs/sectioned_level.md measures the three)."""
+    (docs/sectioned_level.md measures the three). A pull that loosens the knot runs at
+    the compliant level and the sections join its end on the "pull" path too: the loose
+    knot's sections change it little, and the 185 mm trefoil loosened to 1.785 N ends at
+    the same knot either way (Lambda_OC 14.9289 and 14.9291)."""
     if resolved_path(scene, section_path) == "full" or not isinstance(scene.contact,
                                                                      SectionedLayer):
         return scene
@@ -456,7 +461,11 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
         return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                          hold if not scene.closed else 0.0, system)
 
-    if sections is not None:
+    # section_path "pull" on a pull that loosens the knot: the sections join at its end
+    # (their solves through the tighter states on the way cost several compliant ones, and
+    # a knot loosened either way ends where its sections put it, docs/sectioned_level.md).
+    late = sections is not None and _loosens(system, last, pull_force, end_distance, hold)
+    if sections is not None and not late:
         # section_path "pull": the sections join the tightened knot, whose equilibrium
         # with them under the tightening's last load starts the pull.
         done = TieResult(True, "", phases, iters, time.perf_counter() - start, types,
@@ -506,9 +515,25 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
         if pull_force is not None:
             # The force of the last equilibrium (the state kept), not the one aimed at.
             final_force = f0 * (pull_force / f0) ** res.t
-        return fail(f"pull: {res.failure}", system, final_force, res.failed_state)
-    return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
-                     final_force, system)
+        way = " (at the compliant level: the sections join the loosened knot)" if late else ""
+        return fail(f"pull: {res.failure}{way}", system, final_force, res.failed_state)
+    out = TieResult(True, "", phases, iters, time.perf_counter() - start, types, final_force,
+                    system)
+    if late:
+        return (yield from section_finish(sections, out, residual_tol, hook, knot_type,
+                                          end_distance is not None))
+    return out
+
+
+def _loosens(system: RodSystem, last: int, pull_force: float | None,
+             end_distance: float | None, hold: float) -> bool:
+    """Whether the pull of the tightened open knot ``system`` loosens it: a force [N] below
+    the one its held end ``last`` carries (or the hold, where the pull starts), or an end
+    distance [m] shorter than its own."""
+    if pull_force is not None:
+        return pull_force < max(end_reaction(system), hold)
+    x = system.state.x
+    return end_distance < float(np.linalg.norm(x[last] - x[0]))
 
 
 def end_reaction(system: RodSystem) -> float:
