@@ -106,17 +106,17 @@ def test_the_final_path_reaches_the_full_paths_equilibrium() -> None:
 
 
 @pytest.mark.parametrize(("path", "target", "before"),
-                         [("final", 12.0, {"tighten", "pull"}), ("pull", 10.4, {"tighten"}),
-                          ("pull", 12.0, {"tighten", "pull"})])
+                         [("final", 12.0, {"tighten", "pull"}), ("pull", 12.0, {"tighten"}),
+                          ("auto", 10.4, {"tighten"}), ("auto", 12.0, {"tighten", "pull"})])
 def test_an_open_knot_is_sought_with_its_sections(path: str, target: float,
                                                   before: set[str]) -> None:
     """tie_to_lambda on the paths that hand an open knot over to its sections (125 mm rod
     at 100 vertices, tightened to Lambda_OC 10.71 at the compliant level). "final" to 12:
     the force sought at the compliant level, the sections' equilibrium under it (12.16),
-    then the force sought again with them (11.99). "pull" to 10.4: the sections'
-    equilibrium at the tightened knot, then the force sought with them (10.48). "pull" to
-    12, looser than the tightened knot: as "final" (a knot is loosened at the compliant
-    level). From the handover on, every equilibrium carries the sections."""
+    then the force sought again with them (11.99). "pull" to 12: the sections' equilibrium
+    at the tightened knot, then the force sought with them (12.05); "auto" so too where
+    the knot is pulled tighter (to 10.4: 10.48), but as "final" where it is loosened (to
+    12). From the handover on, every equilibrium carries the sections."""
     scene = open_trefoil(0.125, nodes=100, contact="sectioned")
     calls: list[tuple[str, int]] = []
     res = tie_to_lambda(scene, target, section_path=path, hook=lambda phase, system, rec:
@@ -133,20 +133,20 @@ def test_an_open_knot_is_sought_with_its_sections(path: str, target: float,
 
 
 def test_a_pull_that_loosens_the_knot_runs_before_its_sections() -> None:
-    """On the "pull" path a pull by a force below the tightened knot's (125 mm rod at 100
+    """On the "auto" path a pull by a force below the tightened knot's (125 mm rod at 100
     vertices by 1 N: measured Lambda_OC 14.20) runs at the compliant level and the sections
     join at its end, as on the "final" path: the same equilibrium, bit for bit."""
     out = {}
-    for path in ("pull", "final"):
+    for path in ("auto", "final"):
         scene = open_trefoil(0.125, nodes=100, contact="sectioned")
         res = tie(scene, pull_force=1.0, section_path=path).run()
         assert res.converged, res.failure
         assert list(res.phases) == ["tighten", "pull", "section"]
         assert res.system.state.extra.size == scene.contact.dof_count
         out[path] = (res.system.state.x, res.system.state.extra, res.newton_iterations)
-    assert np.array_equal(out["pull"][0], out["final"][0])
-    assert np.array_equal(out["pull"][1], out["final"][1])
-    assert out["pull"][2] == out["final"][2]
+    assert np.array_equal(out["auto"][0], out["final"][0])
+    assert np.array_equal(out["auto"][1], out["final"][1])
+    assert out["auto"][2] == out["final"][2]
 
 
 @pytest.mark.slow

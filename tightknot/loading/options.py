@@ -287,9 +287,9 @@ class LoadPath:
                               "again there), full (every load step with the sections: a "
                               "pulled knot's equilibrium can depend on its path), pull "
                               "(relax and tighten at the compliant level, then the sections "
-                              "added and the knot pulled with them; final where the pull "
-                              "loosens the knot) or auto (final for a "
-                              "closed knot, pull for an open one)")
+                              "added and the knot pulled with them) or auto (final for a "
+                              "closed knot and for an open one whose pull loosens it, pull "
+                              "for an open knot pulled tighter)")
     # A setting of the sectioned level beside its path, not a scene parameter: sweeps run
     # without it, so their case ids stay (tightknot/sweep/cases.py, NOT_CASE_KEYS).
     section_bend_shift: bool = param(False, None, "",

@@ -115,9 +115,9 @@ def tie_to_lambda(
     equilibrium at the force found there and searches the force again from it: the
     sections change the knot length a force gives. With "pull" (and "auto") the knot is
     relaxed and tightened at the compliant level, and the force is sought with the
-    sections from their equilibrium at the tightened knot, or, where the tightened knot is
-    already shorter than ``target`` (the search loosens it), as with "final"; with "full",
-    all with them.
+    sections from their equilibrium at the tightened knot; with "auto" so too, but where
+    the tightened knot is already shorter than ``target`` (the search loosens it) as
+    with "final"; with "full", all with them.
     """
     if scene.closed:
         raise ValueError("tie_to_lambda is for open knots")
@@ -140,12 +140,12 @@ def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: Sear
     if not res.converged:
         return res
     if (via is not scene and resolved_path(scene, section_path) == "pull"
-            and knot_length(via, res.system) > target):
+            and (section_path == "pull" or knot_length(via, res.system) > target)):
         # The sections join the tightened knot and the force is sought with them. Their
         # solves cost several compliant ones, so the search's first step is a secant one
-        # on the compliant level's slope of Lambda_OC in log force at this knot. (A knot
-        # tighter than the target is loosened to it at the compliant level first, below:
-        # the sections join the loosened knot, as in tie().)
+        # on the compliant level's slope of Lambda_OC in log force at this knot. ("auto":
+        # a knot tighter than the target is loosened to it at the compliant level first,
+        # below, and the sections join the loosened knot, as in tie().)
         t0 = time.perf_counter()
         slope, iterations = yield from _compliant_slope(via, res, target, search.step_ratio,
                                                         residual_tol)

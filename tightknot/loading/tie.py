@@ -165,10 +165,10 @@ def tie(
             at the compliant level and solves the sections' equilibrium under its last
             load (:func:`section_finish`); "full" runs every step with the sections;
             "pull" relaxes and tightens at the compliant level, solves the sections'
-            equilibrium there and pulls with them ("final" where nothing is pulled or
-            where the pull loosens the knot: a force below the tightened knot's, an end
-            distance shorter than its own);
-            "auto": "final" for a closed knot, "pull" for an open one.
+            equilibrium there and pulls with them ("final" where nothing is pulled);
+            "auto": "final" for a closed knot and for an open one whose pull loosens it
+            (a force below the tightened knot's, an end distance shorter than its own),
+            "pull" for an open knot pulled tighter.
     """
     if scene.contact is None:
         raise ValueError(f"{scene.name}: contact='off' cannot tie a knot (without self-contact "
@@ -190,7 +190,7 @@ def tie(
                 and resolved_path(scene, section_path) == "pull" else None)
     body = _tie(via, pull_force, end_distance, tighten_steps, pull_steps, residual_tol,
                 hold_force_scale, relax_iterations, hook, attach, start_state, knot_type,
-                sections)
+                sections, loosen_first=section_path == "auto")
     if via is not scene and sections is None:
         body = _then_sections(scene, body, end_distance is not None, residual_tol, hook,
                               knot_type)
@@ -199,8 +199,9 @@ def tie(
 
 def resolved_path(scene: KnotScene, section_path: str = LoadPath.section_path) -> str:
     """``section_path`` ("auto", "final", "full" or "pull") as it runs on ``scene``:
-    "auto" is "final" for a closed knot and "pull" for an open one; "pull" is "final" for a
-    closed knot (nothing is pulled)."""
+    "auto" is "final" for a closed knot and "pull" for an open one (which runs as "final"
+    where the pull loosens the tightened knot, told after the tightening); "pull" is
+    "final" for a closed knot (nothing is pulled)."""
     if section_path not in SECTION_PATHS:
         raise ValueError(f"section_path must be one of {', '.join(SECTION_PATHS)}, got "
                          f"{section_path!r}")
@@ -224,10 +225,10 @@ def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> K
     way there picks one: sections added only under the final force ("final") can settle
     on the other, so "auto" adds them at the tightened knot and pulls with them ("pull"),
     which reaches the knot of a path with the sections all the way ("full")
-    (docs/sectioned_level.md measures the three). A pull that loosens the knot runs at
-    the compliant level and the sections join its end on the "pull" path too: the loose
-    knot's sections change it little, and the 185 mm trefoil loosened to 1.785 N ends at
-    the same knot either way (Lambda_OC 14.9289 and 14.9291)."""
+    (docs/sectioned_level.md measures the three). A pull that loosens the knot ("auto")
+    runs at the compliant level, and the sections join at its end: the 185 mm trefoil
+    loosened to 1.785 N ends at the same knot either way (Lambda_OC 14.9289 and 14.9291),
+    at 1.743 N (170 vertices) one shallow minimum apart (15.089 and 15.034)."""
     if resolved_path(scene, section_path) == "full" or not isinstance(scene.contact,
                                                                      SectionedLayer):
         return scene
@@ -385,10 +386,13 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
          relax_iterations: int, hook: StepHook | None,
          attach: Callable[[RodSystem], None] | None, start_state: State | None,
          knot_type: Callable[[KnotScene, np.ndarray], str],
-         sections: KnotScene | None = None) -> Coroutine[TieResult]:
+         sections: KnotScene | None = None,
+         loosen_first: bool = False) -> Coroutine[TieResult]:
     """The coroutine of :func:`tie` (its arguments checked); with ``sections`` (the
     sectioned scene of the same rod, section_path "pull"), the pull runs on it from the
-    sections' equilibrium at the tightened knot."""
+    sections' equilibrium at the tightened knot, but with ``loosen_first`` (section_path
+    "auto") a pull that loosens the knot runs at this level and the sections join at its
+    end."""
     start = time.perf_counter()
     types: list[str] = []
     phases: dict[str, StaticResult] = {}
@@ -461,10 +465,12 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
         return TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                          hold if not scene.closed else 0.0, system)
 
-    # section_path "pull" on a pull that loosens the knot: the sections join at its end
-    # (their solves through the tighter states on the way cost several compliant ones, and
-    # a knot loosened either way ends where its sections put it, docs/sectioned_level.md).
-    late = sections is not None and _loosens(system, last, pull_force, end_distance, hold)
+    # section_path "auto" on a pull that loosens the knot: the sections join at its end, as
+    # on the "final" path (their solves through the tighter states on the way cost several
+    # compliant ones, and measured, the loosened knot ends within a shallow minimum of the
+    # one loosened with them, docs/sectioned_level.md).
+    late = (sections is not None and loosen_first
+            and _loosens(system, last, pull_force, end_distance, hold))
     if sections is not None and not late:
         # section_path "pull": the sections join the tightened knot, whose equilibrium
         # with them under the tightening's last load starts the pull.
