@@ -30,6 +30,7 @@ def test_the_closed_trefoil_ties_at_the_sectioned_level(sectioned_run) -> None:
     assert isinstance(scene.contact, SectionedLayer)
     assert s["converged"], s["failure"]
     assert s["knot_type"] == "3_1"
+    assert s["section_path"] == "final"  # a closed knot's load path at the compliant level
     # the sections carry the contact: some of their perimeter touches (measured 0.14 at
     # 60 and 100 vertices), none wholly
     assert 0.02 < s["max_contact_width_fraction"] < 1.0
@@ -98,6 +99,7 @@ def test_the_final_path_reaches_the_full_paths_equilibrium() -> None:
     res_final = runs["final"][1]
     assert list(res_final.phases) == ["tighten", "section"]
     assert "section" not in runs["full"][1].phases
+    assert res_final.section_path == "final" and runs["full"][1].section_path == "full"
     # the sectioned level's Newton iterations: one solve against every load step's
     # (measured 140 in all, 267)
     assert res_final.phases["section"].newton_iterations < \
@@ -124,6 +126,7 @@ def test_an_open_knot_is_sought_with_its_sections(path: str, target: float,
     assert res.converged, res.failure
     assert set(res.knot_types) == {"3_1"}
     assert knot_length(scene, res.system) == pytest.approx(target, abs=0.1)
+    assert res.section_path == ("final" if "pull" in before else "pull")
     phases = [c[0] for c in calls]
     first = phases.index("section")
     assert set(phases[:first]) == before and phases.count("section") == 1
@@ -142,6 +145,7 @@ def test_a_pull_that_loosens_the_knot_runs_before_its_sections() -> None:
         res = tie(scene, pull_force=1.0, section_path=path).run()
         assert res.converged, res.failure
         assert list(res.phases) == ["tighten", "pull", "section"]
+        assert res.section_path == "final"
         assert res.system.state.extra.size == scene.contact.dof_count
         out[path] = (res.system.state.x, res.system.state.extra, res.newton_iterations)
     assert np.array_equal(out["auto"][0], out["final"][0])
@@ -164,6 +168,7 @@ def test_the_pull_path_reaches_the_full_paths_knot() -> None:
         assert set(res.knot_types) == {"3_1"}
         assert list(res.phases) == (["tighten", "section", "pull"] if path == "pull"
                                     else ["tighten", "pull"])
+        assert res.section_path == path
         assert res.system.state.extra.size == scene.contact.dof_count
         st = res.system.state
         rep = scene.contact.section_report(st.x, st.extra, st.frames, res.system.rest)

@@ -151,7 +151,8 @@ def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: Sear
                                                         residual_tol)
         res = dataclasses.replace(res, newton_iterations=res.newton_iterations + iterations,
                                   wall_time_s=res.wall_time_s + time.perf_counter() - t0)
-        res = yield from section_finish(scene, res, residual_tol, hook)
+        res = yield from section_finish(scene, dataclasses.replace(res, section_path="pull"),
+                                        residual_tol, hook)
         if not res.converged:
             return res
         return (yield from _seek(scene, res, target, dataclasses.replace(search, secant=True),
@@ -159,7 +160,8 @@ def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: Sear
     res = yield from _seek(via, res, target, search, residual_tol, hook)
     if via is scene or not res.converged:
         return res
-    res = yield from section_finish(scene, res, residual_tol, hook)
+    res = yield from section_finish(scene, dataclasses.replace(res, section_path="final"),
+                                    residual_tol, hook)
     if not res.converged:
         return res
     # (the sections' equilibrium is one under the pull already: no first solve)
@@ -206,7 +208,7 @@ def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions
         return TieResult(not why, f"pull: {why}" if why else "", res.phases,
                          res.newton_iterations + path.iterations,
                          res.wall_time_s + time.perf_counter() - start, types, path.level,
-                         path.system)
+                         path.system, section_path=res.section_path)
 
     if not pulled:
         why = yield from path.solve(path.level)

@@ -72,6 +72,9 @@ class TieResult:
         system: the last phase's system (its state is the result; after a failed load
             step, the last equilibrium).
         failed_state: where the failing load step's solve stopped (None when converged).
+        section_path: the sectioned level's load path as it ran (:func:`path_scene`):
+            "final" (the sections joined at the end), "pull" (at the tightened knot) or
+            "full"; "" for a level without sections.
     """
 
     converged: bool
@@ -83,6 +86,7 @@ class TieResult:
     pull_force_N: float = 0.0
     system: RodSystem | None = None
     failed_state: State | None = None
+    section_path: str = ""
 
 
 def knot_type_of(scene: KnotScene, x: np.ndarray) -> str:
@@ -194,7 +198,15 @@ def tie(
     if via is not scene and sections is None:
         body = _then_sections(scene, body, end_distance is not None, residual_tol, hook,
                               knot_type)
+    elif via is scene and isinstance(scene.contact, SectionedLayer):
+        body = routed(body, "full")
     return Program(body, "tie")
+
+
+def routed(body: Coroutine[TieResult], section_path: str) -> Coroutine[TieResult]:
+    """``body``'s result with its :attr:`TieResult.section_path` set."""
+    res = yield from body
+    return dataclasses.replace(res, section_path=section_path)
 
 
 def resolved_path(scene: KnotScene, section_path: str = LoadPath.section_path) -> str:
@@ -244,7 +256,8 @@ def _then_sections(scene: KnotScene, path: Coroutine[TieResult], end_held: bool,
     if not res.converged:
         return dataclasses.replace(res, failure=f"{res.failure} (on the way, at the "
                                    "compliant level: section_path final)")
-    return (yield from section_finish(scene, res, residual_tol, hook, knot_type, end_held))
+    return (yield from section_finish(scene, dataclasses.replace(res, section_path="final"),
+                                      residual_tol, hook, knot_type, end_held))
 
 
 def system_at(scene: KnotScene, done: RodSystem, history: bool = False) -> RodSystem:
@@ -378,7 +391,7 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     force = end_reaction(system) if end_held and not why else res.pull_force_N
     return TieResult(not why, f"section: {why}" if why else "", phases,
                      res.newton_iterations + iters, res.wall_time_s + wall, types, force,
-                     system, failed)
+                     system, failed, res.section_path)
 
 
 def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
@@ -476,7 +489,8 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
         # with them under the tightening's last load starts the pull.
         done = TieResult(True, "", phases, iters, time.perf_counter() - start, types,
                          hold, system)
-        res = yield from section_finish(sections, done, residual_tol, hook, knot_type)
+        res = yield from section_finish(sections, dataclasses.replace(done, section_path="pull"),
+                                        residual_tol, hook, knot_type)
         if not res.converged:
             return res
         phases, iters, types = dict(res.phases), res.newton_iterations, list(res.knot_types)
@@ -522,12 +536,17 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
             # The force of the last equilibrium (the state kept), not the one aimed at.
             final_force = f0 * (pull_force / f0) ** res.t
         way = " (at the compliant level: the sections join the loosened knot)" if late else ""
-        return fail(f"pull: {res.failure}{way}", system, final_force, res.failed_state)
+        out = fail(f"pull: {res.failure}{way}", system, final_force, res.failed_state)
+        return (dataclasses.replace(out, section_path="pull")
+                if sections is not None and not late else out)
     out = TieResult(True, "", phases, iters, time.perf_counter() - start, types, final_force,
                     system)
     if late:
-        return (yield from section_finish(sections, out, residual_tol, hook, knot_type,
-                                          end_distance is not None))
+        out = yield from section_finish(sections, dataclasses.replace(out, section_path="final"),
+                                        residual_tol, hook, knot_type,
+                                        end_distance is not None)
+    elif sections is not None:
+        out = dataclasses.replace(out, section_path="pull")
     return out
 
 

@@ -179,6 +179,9 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         # which library solved the Newton systems (the sectioned level's: PARDISO where
         # installed), since round-off can pick between a knot's nearby equilibria
         "linear_solver": getattr(res.system.linear, "name", "superlu"),
+        # the sectioned level's load path as it ran ("final", "pull" or "full": "auto"
+        # picks by the knot and by whether its pull loosens it); null without sections
+        "section_path": res.section_path or None,
         "nodes": scene.model.vertex_count,
         "diameter_m": scene.diameter,
         "rest_length_m": scene.rest_length,
