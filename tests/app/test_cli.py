@@ -326,6 +326,14 @@ def test_section_thinning_without_the_sectioned_level_exits_2(tmp_path, capsys) 
     assert not out.exists()
 
 
+def test_a_section_path_without_the_sectioned_level_exits_2(tmp_path, capsys) -> None:
+    out = tmp_path / "run"
+    assert main(["tie", "open", "--contact", "compliant", "--section-path", "pull",
+                 "--force", "1", "--nodes", "60", "--out", str(out)]) == 2
+    assert "section_path" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_an_unknown_section_thinning_exits_2(tmp_path, capsys) -> None:
     out = tmp_path / "run"
     with pytest.raises(SystemExit) as bad:  # argparse's choices: exit code 2

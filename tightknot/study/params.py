@@ -271,6 +271,10 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
     if thinning != "edge" and values["contact"] != "sectioned":
         raise ValueError(f"section_thinning: {thinning} needs contact sectioned, got contact "
                          f"{values['contact']}")
+    path = values.get("section_path", "auto")
+    if path != "auto" and values["contact"] != "sectioned":
+        raise ValueError(f"section_path: {path} needs contact sectioned (the load path of "
+                         f"its sections), got contact {values['contact']}")
     contact = (SectionSettings(max_mode=values["section_modes"], bend_shift=shift,
                                thinning=thinning)
                if values["contact"] == "sectioned" else values["contact"])
