@@ -199,11 +199,11 @@ def tie(
         body = _then_sections(scene, body, end_distance is not None, residual_tol, hook,
                               knot_type)
     elif via is scene and isinstance(scene.contact, SectionedLayer):
-        body = routed(body, "full")
+        body = _routed(body, "full")
     return Program(body, "tie")
 
 
-def routed(body: Coroutine[TieResult], section_path: str) -> Coroutine[TieResult]:
+def _routed(body: Coroutine[TieResult], section_path: str) -> Coroutine[TieResult]:
     """``body``'s result with its :attr:`TieResult.section_path` set."""
     res = yield from body
     return dataclasses.replace(res, section_path=section_path)
