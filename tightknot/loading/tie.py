@@ -416,10 +416,13 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
     hold = hold_force_scale * f_unit
     axis = scene.pull_axis if scene.pull_axis is not None else np.zeros(3)
 
+    # the sectioned level's path once the sections have joined (TieResult.section_path)
+    route = ""
+
     def fail(msg: str, system: RodSystem | None, force: float,
              failed_state: State | None = None) -> TieResult:
         return TieResult(False, msg, phases, iters, time.perf_counter() - start, types,
-                         force, system, failed_state)
+                         force, system, failed_state, route)
 
     # Phase 1: shrink the rest length from the start to L0.
     shrink = 1.0 / scene.start_length_ratio
@@ -487,10 +490,10 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
     if sections is not None and not late:
         # section_path "pull": the sections join the tightened knot, whose equilibrium
         # with them under the tightening's last load starts the pull.
+        route = "pull"
         done = TieResult(True, "", phases, iters, time.perf_counter() - start, types,
-                         hold, system)
-        res = yield from section_finish(sections, dataclasses.replace(done, section_path="pull"),
-                                        residual_tol, hook, knot_type)
+                         hold, system, section_path=route)
+        res = yield from section_finish(sections, done, residual_tol, hook, knot_type)
         if not res.converged:
             return res
         phases, iters, types = dict(res.phases), res.newton_iterations, list(res.knot_types)
@@ -536,17 +539,14 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
             # The force of the last equilibrium (the state kept), not the one aimed at.
             final_force = f0 * (pull_force / f0) ** res.t
         way = " (at the compliant level: the sections join the loosened knot)" if late else ""
-        out = fail(f"pull: {res.failure}{way}", system, final_force, res.failed_state)
-        return (dataclasses.replace(out, section_path="pull")
-                if sections is not None and not late else out)
-    out = TieResult(True, "", phases, iters, time.perf_counter() - start, types, final_force,
-                    system)
+        return fail(f"pull: {res.failure}{way}", system, final_force, res.failed_state)
     if late:
-        out = yield from section_finish(sections, dataclasses.replace(out, section_path="final"),
-                                        residual_tol, hook, knot_type,
+        route = "final"
+    out = TieResult(True, "", phases, iters, time.perf_counter() - start, types, final_force,
+                    system, section_path=route)
+    if late:
+        out = yield from section_finish(sections, out, residual_tol, hook, knot_type,
                                         end_distance is not None)
-    elif sections is not None:
-        out = dataclasses.replace(out, section_path="pull")
     return out
 
 
