@@ -238,9 +238,9 @@ def path_scene(scene: KnotScene, section_path: str = LoadPath.section_path) -> K
     on the other, so "auto" adds them at the tightened knot and pulls with them ("pull"),
     which reaches the knot of a path with the sections all the way ("full")
     (docs/sectioned_level.md measures the three). A pull that loosens the knot ("auto")
-    runs at the compliant level, and the sections join at its end: the 185 mm trefoil
-    loosened to 1.785 N ends at the same knot either way (Lambda_OC 14.9289 and 14.9291),
-    at 1.743 N (170 vertices) one shallow minimum apart (15.089 and 15.034)."""
+    runs at the compliant level, and the sections join at its end: loosened either way, a
+    knot ends at the same equilibrium or one shallow minimum from it (docs/sectioned_level.md,
+    "`auto` loosens at the compliant level", compares the two at equal force)."""
     if resolved_path(scene, section_path) == "full" or not isinstance(scene.contact,
                                                                      SectionedLayer):
         return scene
