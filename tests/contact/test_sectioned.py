@@ -12,6 +12,7 @@ import warp as wp
 from tightknot.contact import sectioned
 from tightknot.contact import sectioned_kernels as sk
 from tightknot.contact.section_modes import mode_stiffness
+from tightknot.contact.section_squeeze import rounded_penalty
 from tightknot.contact.sectioned import SectionedLayer, SectionSettings
 from tightknot.contact.sectioned_reference import (
     EdgeSection,
@@ -104,10 +105,11 @@ def test_oracle_derivatives_match_finite_differences() -> None:
     assert np.linalg.norm(h - h_fd) / np.linalg.norm(h_fd) < 1e-3
 
 
-def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, np.ndarray,
-                                                                         np.ndarray]:
+def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool, gauss_newton: int = 0
+                 ) -> tuple[float, np.ndarray, np.ndarray]:
     """Energy, gradient and Hessian of the pair from the Warp kernel (both passes, node
-    blocks unpacked to the pair's local dofs)."""
+    blocks unpacked to the pair's local dofs); ``gauss_newton``: its Gauss-Newton
+    Hessian."""
     f = wp.float64
 
     def arr(x, dt):
@@ -121,7 +123,7 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
              arr([0, int(rigid_b)], wp.int32), arr(offs, wp.int32),
              arr([[0, 0], [0, 0]], wp.vec2i), arr([0.0, 0.0], f), arr(GAUSS[0], f),
              arr(GAUSS[1], f), arr(np.cos(phi), f), arr(np.sin(phi), f), K, 32, 1000.0,
-             1e-4, 0]
+             1e-4, 0, gauss_newton]
     x = arr(np.array([a.x0, a.x1, b.x0, b.x1]), wp.vec3d)
     coeff = arr(np.concatenate([a.coeffs0, a.coeffs1, b.coeffs0, b.coeffs1]), f)
     rest, lam = arr([a.rest, b.rest], f), arr([1.0], f)
@@ -154,9 +156,10 @@ def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool) -> tuple[float, 
 
 @pytest.mark.parametrize("rigid_b", [False, True])
 def test_kernel_matches_the_oracle(rigid_b: bool) -> None:
-    a, b = _pair(3)
+    a, b = _pair()
     b.rigid = rigid_b
     ref = pair_terms(a, b, SETTINGS)
+    assert ref["energy"] > 0.0  # a contact (seed 3's deformable pair touches nowhere)
     energy, grad, hess = _kernel_pass(a, b, rigid_b)
     keep = np.r_[0:12 + 2 * K] if rigid_b else np.r_[0:12 + 4 * K]  # b rigid: no dofs
     # the same formulas in float64, the frames' differences included: round-off only
@@ -165,6 +168,46 @@ def test_kernel_matches_the_oracle(rigid_b: bool) -> None:
     assert np.max(np.abs(grad[keep] - ref["grad"][keep])) <= 1e-12 * np.max(np.abs(ref["grad"]))
     rh = ref["hess"][np.ix_(keep, keep)]
     assert np.max(np.abs(hess[np.ix_(keep, keep)] - rh)) <= 1e-10 * np.max(np.abs(rh))
+
+
+@pytest.mark.parametrize("rigid_b", [False, True])
+def test_the_gauss_newton_hessian_is_the_penetrations_outer_products(rigid_b: bool) -> None:
+    # SectionedLayer.set_gauss_newton: per sample a_s wt phi''(pen) grad(pen) grad(pen)^T,
+    # here with the penetrations' gradients by central differences of the oracle's, so
+    # positive semidefinite; energy and gradient those of the exact kernel, bit for bit.
+    a, b = _pair()
+    b.rigid = rigid_b
+    q0 = _pack(a, b)
+    energy, grad, hess = _kernel_pass(a, b, rigid_b)
+    e_gn, g_gn, h_gn = _kernel_pass(a, b, rigid_b, gauss_newton=1)
+    assert e_gn == energy and np.array_equal(g_gn, grad)
+    ref = pair_terms(a, b, SETTINGS)
+    assert ref["energy"] > 0.0
+    eps = 1e-7
+    jac = np.zeros((2, ref["pen_a"].size, q0.size))
+    for i in range(q0.size):
+        dq = np.zeros(q0.size)
+        dq[i] = eps
+        hi = pair_terms(*_unpack(a, b, q0 + dq), SETTINGS, want_hess=False)
+        lo = pair_terms(*_unpack(a, b, q0 - dq), SETTINGS, want_hess=False)
+        for side, key in enumerate(("pen_a", "pen_b")):
+            jac[side, :, i] = (hi[key] - lo[key]) / (2 * eps)
+    expected = np.zeros((q0.size, q0.size))
+    for side, (edge, key) in enumerate(((a, "a"), (b, "b"))):
+        pen, wt = ref[f"pen_{key}"], ref[f"weight_{key}"]
+        a_s = 0.5 * np.repeat(GAUSS[1], 32) * edge.rest * edge.r0 * 2.0 * np.pi / 32
+        d2phi = rounded_penalty(pen, SETTINGS.kappa, SETTINGS.onset)[2]
+        c = np.where((pen > 0.0) & (wt > 0.0), a_s * wt * d2phi, 0.0)
+        expected += jac[side].T @ (c[:, None] * jac[side])
+    keep = np.r_[0:12 + 2 * K] if rigid_b else np.r_[0:12 + 4 * K]
+    ex = expected[np.ix_(keep, keep)]
+    # the penetrations are smooth: their differences carry truncation eps^2 and round-off
+    # 1e-16 / eps (measured 5e-10 and 4e-10 of the largest entry)
+    assert np.max(np.abs(h_gn[np.ix_(keep, keep)] - ex)) <= 1e-6 * np.max(np.abs(ex))
+    # the exact Hessian of this contact is indefinite; the Gauss-Newton one is not
+    assert np.linalg.eigvalsh(hess[np.ix_(keep, keep)])[0] < 0.0
+    lam = np.linalg.eigvalsh(h_gn[np.ix_(keep, keep)])
+    assert lam[0] >= -1e-12 * lam[-1]
 
 
 def test_kernel_twist_columns_are_the_gradients_derivatives_in_the_end_twists() -> None:

@@ -105,6 +105,8 @@ def _chunk_pool() -> ThreadPoolExecutor:
 
 #: Index of the penalty among a pass kernel's model arguments (``SectionedLayer._model_args``).
 _PENALTY_ARG = 16
+#: Index of the Gauss-Newton switch among them (:meth:`SectionedLayer.set_gauss_newton`).
+_GAUSS_NEWTON_ARG = 19
 
 _CALIBRATION_FILE = Path(__file__).resolve().parents[1] / "data" / "section_calibration.json"
 
@@ -363,11 +365,14 @@ class SectionedLayer(ContactLayer):
             self.broad_phase.edge_exclusion,
             wp.array(g_xi, dtype=f64, device=dev), wp.array(g_w, dtype=f64, device=dev),
             sample_cos, sample_sin, k, samples, float(self.penalty), float(self.section.onset),
-            rod_mean,
+            rod_mean, 0,
         ]
         assert self._model_args[_PENALTY_ARG] == float(self.penalty)
+        assert self._model_args[_GAUSS_NEWTON_ARG] == 0
         #: The factor on the penalty of the contact kernels (:meth:`set_penalty_scale`).
         self.penalty_scale = 1.0
+        #: Whether the contact's Hessian is its Gauss-Newton part (:meth:`set_gauss_newton`).
+        self.gauss_newton = False
         # the inputs of sk.section_bounds before the state's, and its outputs
         self._bounds_args = [self.broad_phase.edge_vertex, vertex_offset, edge_r0, edge_nu,
                              edge_rigid, k, rod_mean]
@@ -399,6 +404,15 @@ class SectionedLayer(ContactLayer):
         self._model_args[_PENALTY_ARG] = float(self.penalty) * float(scale)
         self.penalty_scale = float(scale)
         self._energy_only = None
+
+    def set_gauss_newton(self, on: bool) -> None:
+        """Evaluate the contact's Gauss-Newton Hessian (``on``) instead of its exact one:
+        per sample only the penalty's curvature times the outer product of the
+        penetration's gradient, positive semidefinite, without the gap's own curvature
+        weighed by the penalty's slope (which makes a deep contact's exact Hessian
+        indefinite). Energy and gradient are unchanged."""
+        self._model_args[_GAUSS_NEWTON_ARG] = int(bool(on))
+        self.gauss_newton = bool(on)
 
     def set_shift_scale(self, scale: float) -> None:
         """Apply the fraction ``scale`` in (0, 1] of the bend shift (a continuation path's

@@ -22,6 +22,12 @@ one block per pair of its nodes (the coordinates' 12 x 12, the coordinates again
 coefficients, the coefficients' K x K blocks), which are added into the node-pair blocks
 once per pass.
 
+With ``gauss_newton`` set (:meth:`tightknot.contact.sectioned.SectionedLayer.
+set_gauss_newton`), a sample's Hessian is its Gauss-Newton part alone, a_s wt phi''(pen)
+grad(pen) grad(pen)^T: every term weighed by the penalty's slope or the partition's
+derivatives (the gap's own curvature, the mean radii's second derivatives, P's second
+derivatives in A's edge vector) is left out; energy and gradient are unchanged.
+
 Work is skipped where no contact can be: a pass whose edges lie farther apart than the
 two sections' largest radii, a Gauss circle of A whose axis point is farther from B's axis
 than those radii, and a sample farther from B's axis than B's largest radius (the bounds:
@@ -685,6 +691,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         penalty: wp.float64,
         onset: wp.float64,
         rod_mean: int,
+        gauss_newton: int,
         # Data in:
         x_in: wp.array(dtype=wp.vec3d),
         coeff_in: wp.array(dtype=wp.float64),
@@ -963,9 +970,22 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     c_gv = a_s * ph[1] * wt1
                     c_vv = a_s * ph[0] * wt2
                     c_v = a_s * ph[0] * wt1
-                    h6 = (c_gg * wp.outer(g_we, g_we) - c_gv * (wp.outer(g_we, gv)
-                                                                + wp.outer(gv, g_we))
-                          + c_vv * wp.outer(gv, gv) - c_g * h_we + c_v * cyl.hv)
+                    # The Hessian's terms that carry the penalty's or the partition's
+                    # first derivative (the gap's and the weights' own curvature); the
+                    # Gauss-Newton Hessian (gauss_newton) keeps only c_gg's, the outer
+                    # product of the penetration's gradient: positive semidefinite.
+                    hc_g = c_g
+                    hc_gv = c_gv
+                    hc_vv = c_vv
+                    hc_v = c_v
+                    if gauss_newton != 0:
+                        hc_g = f64(0.0)
+                        hc_gv = f64(0.0)
+                        hc_vv = f64(0.0)
+                        hc_v = f64(0.0)
+                    h6 = (c_gg * wp.outer(g_we, g_we) - hc_gv * (wp.outer(g_we, gv)
+                                                                 + wp.outer(gv, g_we))
+                          + hc_vv * wp.outer(gv, gv) - hc_g * h_we + hc_v * cyl.hv)
                     h = reduce_mat(h6, dp_de, dirv, 1 - rig_a)
                     jg = reduce_vec(g_we, dp_de, dirv, 1 - rig_a)
                     jq = reduce_vec(gv, dp_de, dirv, 1 - rig_a)
@@ -976,21 +996,21 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         js = reduce_vec(gpsi, dp_de, dirv, 1 - rig_a)
                         r_grad[13] = c_g
                         for c in range(13):
-                            v13 = -c_gg * jg[c] + c_gv * jq[c]
+                            v13 = -c_gg * jg[c] + hc_gv * jq[c]
                             h[c, 13] = h[c, 13] + v13
                             h[13, c] = h[13, c] + v13
-                            h[c, 14] = h[c, 14] + c_g * js[c]
-                            h[14, c] = h[14, c] + c_g * js[c]
-                            h[c, 15] = h[c, 15] + c_g * jq[c]
-                            h[15, c] = h[15, c] + c_g * jq[c]
+                            h[c, 14] = h[c, 14] + hc_g * js[c]
+                            h[14, c] = h[14, c] + hc_g * js[c]
+                            h[c, 15] = h[c, 15] + hc_g * jq[c]
+                            h[15, c] = h[15, c] + hc_g * jq[c]
                         h[13, 13] = h[13, 13] + c_gg
                     # P's own second derivatives in A's edge vector, contracted with the
                     # energy's gradient over w (linear in it: one contraction for both
                     # the penetration's and the partition's parts)
                     hra = ((ra_llx / (rest_in[ea] * rest_in[ea])) * wp.outer(ta, ta)
                            + (ra_lx / (la * rest_in[ea])) * (eye - wp.outer(ta, ta)))
-                    gw = (-c_g * wp.vec3d(g_we[0], g_we[1], g_we[2])
-                          + c_v * wp.vec3d(gv[0], gv[1], gv[2]))
+                    gw = (-hc_g * wp.vec3d(g_we[0], g_we[1], g_we[2])
+                          + hc_v * wp.vec3d(gv[0], gv[1], gv[2]))
                     row = wp.transpose(m_dir) @ gw
                     pee = (r_a * (cphi * contract(gw, fa.t1x, fa.t1y, fa.t1z)
                                   + sphi * contract(gw, fa.t2x, fa.t2y, fa.t2z))
@@ -1085,12 +1105,12 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     # R_cc dc/dv = z = -dc / (2 R) - (c . dc) c / (4 R^3) three (dc_b, c_B0,
                     # c_B1'), so sums of moments in v carry them.
                     hit = 1
-                    if rig_a == 0:
+                    if rig_a == 0 and gauss_newton == 0:
                         ga_sum += r_grad[12]
                     if rig_b == 0:
-                        al = c_g / (f64(2.0) * rb_mean)
-                        be = c_g / (f64(4.0) * rb_mean * rb_mean * rb_mean)
-                        ga = c_g * rb_lx / (f64(2.0) * rb_mean * rb_mean)
+                        al = hc_g / (f64(2.0) * rb_mean)
+                        be = hc_g / (f64(4.0) * rb_mean * rb_mean * rb_mean)
+                        ga = hc_g * rb_lx / (f64(2.0) * rb_mean * rb_mean)
                         mv = wp.vec3d(one_v * one_v, one_v * v, v * v)
                         mom_a = mom_a + al * mv
                         mom_g = mom_g + ga * mv
@@ -1107,12 +1127,13 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         zc = wp.vec3d(-f64(1.0) / (f64(2.0) * rb_mean), -cdc * one_v, -cdc * v)
                         for q in range(3):
                             for i in range(12):
-                                zx[i, q] = zx[i, q] + c_g * one_v * zc[q] * jq[i]
-                                zx[i, 3 + q] = zx[i, 3 + q] + c_g * v * zc[q] * jq[i]
+                                zx[i, q] = zx[i, q] + hc_g * one_v * zc[q] * jq[i]
+                                zx[i, 3 + q] = zx[i, 3 + q] + hc_g * v * zc[q] * jq[i]
                             if rig_a == 0:
                                 for j in range(k):
-                                    za[q, j] = za[q, j] + c_g * jq[12] * one_v * zc[q] * ba[j]
-                                    za[3 + q, j] = za[3 + q, j] + c_g * jq[12] * v * zc[q] * ba[j]
+                                    za[q, j] = za[q, j] + hc_g * jq[12] * one_v * zc[q] * ba[j]
+                                    za[3 + q, j] = (za[3 + q, j]
+                                                    + hc_g * jq[12] * v * zc[q] * ba[j])
                     touched = 1
             if wp.static(derivatives):
                 if hit != 0:
