@@ -45,6 +45,25 @@ def test_non_convergence_is_reported_not_nan() -> None:
     assert np.isfinite(system.state.x).all()
 
 
+def test_a_relative_tolerance_stops_at_its_fraction_of_the_start() -> None:
+    # relative_tol: the first iterate below a tenth of the start's residual ends the solve
+    # as converged (the full solve goes on below it), and its value is checked.
+    full = _cantilever()
+    full.set_load(1.0)
+    whole = newton(full, full.free_vector(), NewtonOptions(max_iterations=100)).run()
+    system = _cantilever()
+    system.set_load(1.0)
+    part = newton(system, system.free_vector(),
+                  NewtonOptions(max_iterations=100, relative_tol=0.1)).run()
+    assert whole.converged and part.converged
+    h = part.history
+    assert h[-1] <= 0.1 * h[0] and all(r > 0.1 * h[0] for r in h[:-1])
+    assert part.iterations < whole.iterations and whole.history[:len(h)] == h
+    for bad in (-0.1, 1.0, float("nan")):
+        with pytest.raises(ValueError, match="relative_tol"):
+            NewtonOptions(relative_tol=bad)
+
+
 def test_converges_quadratically_near_solution() -> None:
     system = _cantilever(load_parameter=1.0)
     res = continuation(system, ContinuationOptions(steps=4)).run()

@@ -41,6 +41,9 @@ class NewtonOptions:
 
     Attributes:
         residual_tol: converged when the scaled residual is below this [-].
+        relative_tol: converged also when the scaled residual is below this fraction of
+            its value at the start (0: off), for a solve that only brings a later one
+            near its solution [-].
         step_tol: a step below this (scaled) that did not cut the residual by
             ``stall_factor`` is stagnation.
         max_iterations: iteration limit.
@@ -74,6 +77,7 @@ class NewtonOptions:
     """
 
     residual_tol: float = 1e-8
+    relative_tol: float = 0.0
     step_tol: float = 1e-13
     max_iterations: int = 100
     armijo: float = 1e-4
@@ -99,6 +103,8 @@ class NewtonOptions:
             v = getattr(self, name)
             if not (isinstance(v, numbers.Integral) and v >= low):
                 raise ValueError(f"{name} must be a whole number >= {low}, got {v!r}")
+        if not (isinstance(self.relative_tol, numbers.Real) and 0.0 <= self.relative_tol < 1.0):
+            raise ValueError(f"relative_tol must be in [0, 1), got {self.relative_tol!r}")
         if self.stall_factor >= 1.0:
             raise ValueError(f"stall_factor must be in (0, 1), got {self.stall_factor!r}")
 
@@ -145,6 +151,8 @@ def newton(p: RodSystem, u0: np.ndarray, options: NewtonOptions | None = None) -
     if not math.isfinite(res):  # e.g. a zero force scale (a rod without stiffness)
         return NewtonResult(False, 0, math.inf, math.inf, energy, "non_finite")
     history = [res]
+    if opt.relative_tol > 0.0:
+        tol = max(tol, opt.relative_tol * res)
     mu = 0.0
     step = math.inf
     if res <= tol:
