@@ -244,6 +244,36 @@ def _closed_length(y: np.ndarray) -> float:
     return float(np.linalg.norm(np.roll(y, -1, axis=0) - y, axis=1).sum())
 
 
+def test_the_first_section_solve_starts_with_gauss_newton_steps(monkeypatch) -> None:
+    """section_finish's first solve takes Gauss-Newton steps until the residual is a
+    fraction of its start, then exact Newton steps to the tolerance; its record holds both
+    (iterations and residuals), and the layer's Hessian is exact again after it."""
+    import tightknot.loading.tie as tie_module
+
+    real = tie_module.static_solve
+    scene = closed_trefoil(16.37, nodes=40, contact="sectioned")
+    calls: list[tuple] = []
+
+    def spy(system, newton_options, *args, **kwargs):
+        calls.append((scene.contact.gauss_newton, newton_options.max_iterations,
+                      newton_options.relative_tol))
+        r = yield from real(system, newton_options, *args, **kwargs)
+        calls[-1] += (r[0].iterations,)
+        return r
+
+    res = _tied_final_with(monkeypatch, scene, spy)
+    first = [i for i, c in enumerate(calls) if c[0]]
+    assert len(first) == 1, calls
+    gn, exact = calls[first[0]], calls[first[0] + 1]
+    assert gn[:3] == (True, tie_module.GAUSS_NEWTON_ITERATIONS,
+                      tie_module.GAUSS_NEWTON_FRACTION)
+    assert exact[:3] == (False, tie_module.DIRECT_SECTION_ITERATIONS, 0.0)
+    assert not scene.contact.gauss_newton
+    newton_rec = res.phases["section"].steps[0].newton
+    assert newton_rec.iterations == gn[3] + exact[3] == len(newton_rec.history) - 1
+    assert newton_rec.history[gn[3]] <= tie_module.GAUSS_NEWTON_FRACTION * newton_rec.history[0]
+
+
 def test_a_failed_shifted_section_solve_grows_the_shift_from_its_start(monkeypatch) -> None:
     """With the bend shift, where Newton fails from the round sections (the shift moves a
     tight knot's inner sides toward their partners at once: the 125 mm open knot's first
@@ -262,6 +292,8 @@ def test_a_failed_shifted_section_solve_grows_the_shift_from_its_start(monkeypat
     seen: list[tuple[float, float]] = []
 
     def lost(system, newton_options, *args, **kwargs):
+        if scene.contact.gauss_newton:  # the first solve's Gauss-Newton phase
+            return (yield from real(system, newton_options, *args, **kwargs))
         seen.append((scene.contact.shift.scale, scene.contact.penalty_scale))
         if newton_options.max_iterations == tie_module.DIRECT_SECTION_ITERATIONS \
                 and len(seen) == 1:
@@ -295,6 +327,8 @@ def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch,
     seen: list[float] = []
 
     def lost(system, newton_options, *args, **kwargs):
+        if scene.contact.gauss_newton:  # the first solve's Gauss-Newton phase
+            return (yield from real(system, newton_options, *args, **kwargs))
         scale = scene.contact.penalty_scale
         seen.append(scale)
         direct = (newton_options.max_iterations == tie_module.DIRECT_SECTION_ITERATIONS

@@ -274,6 +274,10 @@ def system_at(scene: KnotScene, done: RodSystem, history: bool = False) -> RodSy
 
 #: Newton iterations of :func:`section_finish`'s first solve at the full penalty.
 DIRECT_SECTION_ITERATIONS = 150
+#: The residual, as a fraction of its start, at which :func:`section_finish`'s first solve
+#: leaves its Gauss-Newton phase for the exact Hessian, and that phase's most iterations.
+GAUSS_NEWTON_FRACTION = 0.1
+GAUSS_NEWTON_ITERATIONS = 20
 #: The penalty factors of :func:`section_finish`'s homotopy, the last the level's own.
 PENALTY_HOMOTOPY = (0.125, 0.25, 0.5, 1.0)
 #: The fractions of the bend shift in :func:`section_finish`'s shift homotopy, the last
@@ -311,13 +315,47 @@ def _retriable(r: NewtonResult, system: RodSystem) -> bool:
     return not r.converged and system.violation is None and r.reason != "passed_through"
 
 
+def _direct_solve(system: RodSystem, layer: object, options: NewtonOptions
+                  ) -> Coroutine[tuple[NewtonResult, int]]:
+    """:func:`section_finish`'s first solve of ``system`` from round sections: on the
+    sectioned level a Gauss-Newton phase first (the contact's Hessian without the gaps'
+    own curvature, :meth:`SectionedLayer.set_gauss_newton`) until the residual is
+    :data:`GAUSS_NEWTON_FRACTION` of its start (at most :data:`GAUSS_NEWTON_ITERATIONS`
+    iterations), then Newton with the exact Hessian (``options``) to convergence. The
+    result spans both (iterations summed, residual histories joined); the iterations
+    spent."""
+    first = None
+    iters = 0
+    if isinstance(layer, SectionedLayer):
+        # Round sections start inside their partners (a compliant knot's overlaps), where
+        # the penalty's slope times the gaps' curvature makes the exact Hessian strongly
+        # indefinite: its shifted steps crawl. The contact's Gauss-Newton Hessian is positive
+        # semidefinite there (Nocedal & Wright 2006 sec. 10.3), and its steps bring the
+        # sections out to where the exact one converges fast.
+        layer.set_gauss_newton(True)
+        try:
+            first, iters, _ = yield from static_solve(
+                system, dataclasses.replace(options, max_iterations=GAUSS_NEWTON_ITERATIONS,
+                                            relative_tol=GAUSS_NEWTON_FRACTION), None, 0)
+        finally:
+            layer.set_gauss_newton(False)
+        if first.reason == "passed_through":
+            return first, iters
+    r, more, _ = yield from static_solve(system, options, None, 0)
+    if first is not None:
+        r = dataclasses.replace(r, iterations=first.iterations + r.iterations,
+                                history=first.history + r.history[1:])
+    return r, iters + more
+
+
 def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
                    hook: StepHook | None = None,
                    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
                    end_held: bool = False) -> Coroutine[TieResult]:
     """The equilibrium of ``scene`` at its own contact level under the last load of
     ``res``, a converged load path of the same rod at another level (:func:`path_scene`):
-    one static solve from its equilibrium, round sections added (where Newton fails
+    one static solve from its equilibrium, round sections added (Gauss-Newton steps
+    first, :func:`_direct_solve`; where Newton fails
     within :data:`DIRECT_SECTION_ITERATIONS`, the same start again with the bend shift
     grown by :data:`SHIFT_HOMOTOPY` where the level has one, then with the penalty grown
     by :data:`PENALTY_HOMOTOPY` (:func:`_homotopy`), then proximal steps alone), the knot
@@ -331,15 +369,14 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
     system = system_at(scene, done, history=True)
     start = system.state.copy()
     steps = load_step_options(1, residual_tol)
+    layer = scene.contact
     # A first Newton solve at the full penalty, on a budget of twice the most iterations
     # it took where it converged (27 to 75 on the study's knots, docs/sectioned_level.md).
-    r, iters, _ = yield from static_solve(
-        system, dataclasses.replace(steps.newton, max_iterations=DIRECT_SECTION_ITERATIONS,
-                                    stall_on_residual=True),
-        None, 0)
+    r, iters = yield from _direct_solve(
+        system, layer, dataclasses.replace(
+            steps.newton, max_iterations=DIRECT_SECTION_ITERATIONS, stall_on_residual=True))
     retry = _retriable(r, system)
     tried = [f"Newton {r.reason}"]
-    layer = scene.contact
     homotopies = []
     if isinstance(layer, SectionedLayer):
         if layer.shift is not None:
