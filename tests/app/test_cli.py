@@ -310,28 +310,19 @@ def test_analyze_of_a_tied_open_knot_gives_its_lambda_oc(tmp_path) -> None:
     assert rep["Lambda_OC"] == pytest.approx(data["lambda_oc"], abs=1e-9)
 
 
-def test_a_bend_shift_without_the_sectioned_level_exits_2(tmp_path, capsys) -> None:
+@pytest.mark.parametrize("args, key", [
+    (["closed", "--section-bend-shift", "on"], "section_bend_shift: on"),
+    (["closed", "--section-thinning", "rod"], "section_thinning: rod"),
+    (["open", "--section-path", "pull", "--force", "1"], "section_path: pull"),
+])
+def test_a_section_option_without_the_sectioned_level_exits_2(tmp_path, capsys, args: list,
+                                                              key: str) -> None:
     out = tmp_path / "run"
-    assert main(["tie", "closed", "--contact", "compliant", "--section-bend-shift", "on",
-                 "--nodes", "60", "--out", str(out)]) == 2
-    assert "section_bend_shift" in capsys.readouterr().err
+    assert main(["tie", *args, "--contact", "compliant", "--nodes", "60",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert key in err and "needs contact sectioned" in err and "got contact compliant" in err
     assert not out.exists()  # refused before anything is written
-
-
-def test_section_thinning_without_the_sectioned_level_exits_2(tmp_path, capsys) -> None:
-    out = tmp_path / "run"
-    assert main(["tie", "closed", "--contact", "compliant", "--section-thinning", "rod",
-                 "--nodes", "60", "--out", str(out)]) == 2
-    assert "section_thinning" in capsys.readouterr().err
-    assert not out.exists()
-
-
-def test_a_section_path_without_the_sectioned_level_exits_2(tmp_path, capsys) -> None:
-    out = tmp_path / "run"
-    assert main(["tie", "open", "--contact", "compliant", "--section-path", "pull",
-                 "--force", "1", "--nodes", "60", "--out", str(out)]) == 2
-    assert "section_path" in capsys.readouterr().err
-    assert not out.exists()
 
 
 def test_an_unknown_section_thinning_exits_2(tmp_path, capsys) -> None:

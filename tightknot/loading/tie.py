@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tightknot.contact.layer import ContactLayer
 from tightknot.contact.sectioned import SectionedLayer
 from tightknot.knots import topology
 from tightknot.knots.scenes import (
@@ -315,7 +316,7 @@ def _retriable(r: NewtonResult, system: RodSystem) -> bool:
     return not r.converged and system.violation is None and r.reason != "passed_through"
 
 
-def _direct_solve(system: RodSystem, layer: object, options: NewtonOptions
+def _direct_solve(system: RodSystem, layer: ContactLayer | None, options: NewtonOptions
                   ) -> Coroutine[tuple[NewtonResult, int]]:
     """:func:`section_finish`'s first solve of ``system`` from round sections: on the
     sectioned level a Gauss-Newton phase first (the contact's Hessian without the gaps'

@@ -264,17 +264,16 @@ def build_scene(values: Mapping[str, Any], device: str = "cpu") -> KnotScene:
 
     material = Material(values["youngs_modulus"], values["poisson"], values["density"])
     shift = bool(values.get("section_bend_shift", False))
-    if shift and values["contact"] != "sectioned":
-        raise ValueError(f"section_bend_shift: on needs contact sectioned, got contact "
-                         f"{values['contact']}")
     thinning = values.get("section_thinning", "edge")
-    if thinning != "edge" and values["contact"] != "sectioned":
-        raise ValueError(f"section_thinning: {thinning} needs contact sectioned, got contact "
-                         f"{values['contact']}")
     path = values.get("section_path", "auto")
-    if path != "auto" and values["contact"] != "sectioned":
-        raise ValueError(f"section_path: {path} needs contact sectioned (the load path of "
-                         f"its sections), got contact {values['contact']}")
+    # The sectioned level's own options, each away from its default only with it.
+    for key, value, default, why in (
+            ("section_bend_shift", "on" if shift else "off", "off", ""),
+            ("section_thinning", thinning, "edge", ""),
+            ("section_path", path, "auto", " (the load path of its sections)")):
+        if value != default and values["contact"] != "sectioned":
+            raise ValueError(f"{key}: {value} needs contact sectioned{why}, got contact "
+                             f"{values['contact']}")
     contact = (SectionSettings(max_mode=values["section_modes"], bend_shift=shift,
                                thinning=thinning)
                if values["contact"] == "sectioned" else values["contact"])
