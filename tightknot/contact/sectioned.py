@@ -410,7 +410,9 @@ class SectionedLayer(ContactLayer):
         per sample only the penalty's curvature times the outer product of the
         penetration's gradient, positive semidefinite, without the gap's own curvature
         weighed by the penalty's slope (which makes a deep contact's exact Hessian
-        indefinite). Energy and gradient are unchanged."""
+        indefinite). Energy and gradient are unchanged; the chain rule through the
+        sections' reference twist (:mod:`tightknot.contact.section_twist`) is applied to
+        this Hessian and the gradient as to the exact one."""
         self._model_args[_GAUSS_NEWTON_ARG] = int(bool(on))
         self.gauss_newton = bool(on)
 
