@@ -725,6 +725,11 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         k = coeff_count
         nl = 12 + 4 * k
         ng = gauss_xi.shape[0]
+        # 1 for the exact Hessian, 0 for its Gauss-Newton part (a_s wt phi'' grad(pen)
+        # grad(pen)^T per sample, positive semidefinite)
+        curv = f64(1.0)
+        if gauss_newton != 0:
+            curv = f64(0.0)
         so = tid * ng * samples
         if wp.static(report):
             for q in range(ng * samples):
@@ -971,18 +976,12 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     c_vv = a_s * ph[0] * wt2
                     c_v = a_s * ph[0] * wt1
                     # The Hessian's terms that carry the penalty's or the partition's
-                    # first derivative (the gap's and the weights' own curvature); the
-                    # Gauss-Newton Hessian (gauss_newton) keeps only c_gg's, the outer
-                    # product of the penetration's gradient: positive semidefinite.
-                    hc_g = c_g
-                    hc_gv = c_gv
-                    hc_vv = c_vv
-                    hc_v = c_v
-                    if gauss_newton != 0:
-                        hc_g = f64(0.0)
-                        hc_gv = f64(0.0)
-                        hc_vv = f64(0.0)
-                        hc_v = f64(0.0)
+                    # first derivative (the gap's and the weights' own curvature), which
+                    # the Gauss-Newton Hessian leaves out (curv = 0).
+                    hc_g = curv * c_g
+                    hc_gv = curv * c_gv
+                    hc_vv = curv * c_vv
+                    hc_v = curv * c_v
                     h6 = (c_gg * wp.outer(g_we, g_we) - hc_gv * (wp.outer(g_we, gv)
                                                                  + wp.outer(gv, g_we))
                           + hc_vv * wp.outer(gv, gv) - hc_g * h_we + hc_v * cyl.hv)
