@@ -4,6 +4,11 @@ solver by the environment."""
 
 from __future__ import annotations
 
+import glob
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -140,3 +145,17 @@ def test_a_sectioned_system_solves_with_pardiso_and_the_others_with_superlu(monk
         system = RodSystem(scene.model, scene.state.copy(), gauge(scene))
         system.add_term(scene.contact)
         assert type(system.linear) is kind
+
+
+@needs_mkl
+@pytest.mark.skipif(not glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")),
+                    reason="MKL's runtime is not the environment's mkl wheel")
+def test_mkl_is_loaded_without_importing_pypardiso() -> None:
+    # pypardiso's import builds a solver whose search for MKL walks the whole environment
+    # (most of a second per process): the wheel's runtime is loaded directly, pypardiso
+    # only found.
+    code = ("import sys; from tightknot.solvers import pardiso; "
+            "print(pardiso.available(), 'pypardiso' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.split() == ["True", "False"]

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import ctypes
 import glob
+import importlib.util
 import os
 import sys
 import weakref
@@ -47,13 +48,12 @@ SOLVERS = ("auto", "pardiso", "superlu")
 def _library() -> ctypes.CDLL | None:
     """MKL's runtime (the ``mkl`` wheel's, else where pypardiso finds it), with the
     pardiso entry point typed; None when pypardiso or MKL is not installed."""
-    try:
-        import pypardiso  # noqa: F401  (the supported way in: its presence says MKL's)
-    except ImportError:
+    # pypardiso's presence says MKL's (the supported way in); it is found, not imported:
+    # its import builds a solver whose search for MKL walks the whole environment (most of
+    # a second per process), while the wheel's library sits in the environment's lib/.
+    if importlib.util.find_spec("pypardiso") is None:
         return None
     lib = None
-    # The wheel's library sits in the environment's lib/; pypardiso's own search walks
-    # the whole environment (a second per process).
     for path in sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*"))):
         try:
             lib = ctypes.CDLL(path)
@@ -62,6 +62,8 @@ def _library() -> ctypes.CDLL | None:
             continue
     if lib is None:
         try:
+            import pypardiso
+
             lib = pypardiso.PyPardisoSolver().libmkl
         except (ImportError, OSError):
             return None
