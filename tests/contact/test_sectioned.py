@@ -3,6 +3,7 @@ the Warp kernels against the oracle, the section field's energies, the level ins
 system, bad input."""
 
 import copy
+import dataclasses
 import math
 
 import numpy as np
@@ -25,6 +26,7 @@ from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
 from tightknot.rods.material import Material
 from tightknot.rods.state import State
+from tightknot.rods.term import BlockHessian
 from tightknot.solvers.linear import SparseDirect
 from tightknot.solvers.system import RodSystem
 
@@ -524,6 +526,48 @@ def test_a_grown_pattern_is_the_one_built_afresh() -> None:
     afresh = place(hmat, own)
     for name in ("indptr", "indices", "data"):
         assert np.array_equal(getattr(grown, name), getattr(afresh, name)), name
+
+
+def test_blocks_that_gain_rows_grow_the_kept_pattern_as_built_afresh() -> None:
+    # A kept node pair whose block gains rows or columns past its positions (the bend
+    # shift's and the twist chain's partial blocks, BlockHessian.full_rows/full_cols)
+    # joins the kept union as a shadow pair with the new entries alone
+    # (RodSystem._own_grow): twice in a row (rows, then columns), beside new pairs, the
+    # matrix is the one a union built afresh gives, pattern and values bit for bit.
+    system, _, rng = _crossing_rods(0.995, 1.0, SectionSettings(max_mode=6, samples=32))
+    calls = []
+    place = system._with_own_hessian
+    system._with_own_hessian = lambda hmat, own: calls.append((hmat, own)) or place(hmat, own)
+    system.evaluate(system.free_vector())
+    hmat, own = calls[-1]
+    n, b = own.keys.shape[0], own.blocks.shape[1]
+    every = np.arange(n)
+
+    def hessian(count: int, rows: np.ndarray, cols: np.ndarray) -> BlockHessian:
+        return dataclasses.replace(own, keys=own.keys[:count],
+                                   blocks=rng.normal(size=(count, b, b)),
+                                   full_rows=rows[:count], full_cols=cols[:count])
+
+    def afresh(h: BlockHessian):
+        kept, system._own_pattern = system._own_pattern, None
+        out = place(hmat, h)
+        system._own_pattern = kept
+        return out
+
+    rows0, cols0 = every % 3 == 0, every % 4 == 0
+    system._own_pattern = None
+    place(hmat, hessian(n // 2, rows0, cols0))  # the kept union of half the pairs
+    build = system._own_union
+    more_rows = rows0 | (every % 2 == 0)
+    for rows, cols in ((more_rows, cols0), (more_rows, every >= 0)):
+        h = hessian(n, rows, cols)
+        system._own_union = None  # growth only: a rebuild fails the test
+        grown = place(hmat, h)
+        assert system._own_pattern["shadow"].size > 0
+        system._own_union = build
+        fresh = afresh(h)
+        for name in ("indptr", "indices", "data"):
+            assert np.array_equal(getattr(grown, name), getattr(fresh, name)), name
 
 
 def check_derivatives(system: RodSystem, d0: float, rng: np.random.Generator,

@@ -406,11 +406,16 @@ class RodSystem:
             grown = (found & ((rows_in & ~cache["full_rows"][at])
                               | (cols_in & ~cache["full_cols"][at])))
             if grown.any():
-                # a kept block gains rows or columns: the union is built again
-                same_base = False
-            elif not found.all():
+                # kept blocks gain rows or columns: their new entries join the union as
+                # shadow pairs (the same node pair, only those entries)
+                cache = self._own_grow(cache, own.node_dofs, new_keys[grown],
+                                       rows_in[grown] | cache["full_rows"][at[grown]],
+                                       cols_in[grown] | cache["full_cols"][at[grown]],
+                                       shadow_of=at[grown])
+            if not found.all():
                 cache = self._own_grow(cache, own.node_dofs, new_keys[~found],
                                        rows_in[~found], cols_in[~found])
+            if grown.any() or not found.all():
                 at, _ = _kept_at(cache, new_keys)
         if not same_base:
             if cache is None:
@@ -429,6 +434,8 @@ class RodSystem:
         b = own.blocks.shape[1]
         blocks = np.zeros((cache["keys"].size, b, b))
         blocks[at] = own.blocks
+        if cache["shadow"].size:
+            blocks[cache["shadow"]] = blocks[cache["shadow_src"]]
         data = np.zeros(cache["indices_u"].size)
         data[cache["slot_e"]] = hmat.data
         # each (row, column) entry belongs to one node pair: the slots are distinct
@@ -476,18 +483,27 @@ class RodSystem:
                  "indptr": hmat.indptr.copy(), "indices": hmat.indices.copy(),
                  "valid": valid, "slot_e": slots[:hmat.nnz], "slot_t": slots[hmat.nnz:],
                  "lin_u": lin_u, "indptr_u": union.indptr, "indices_u": union.indices,
-                 "size": size}
+                 "size": size, "shadow": np.zeros(0, np.int64),
+                 "shadow_src": np.zeros(0, np.int64)}
         self._own_pattern = cache
         return cache
 
     def _own_grow(self, cache: dict, node_dofs: np.ndarray, add_keys: np.ndarray,
-                  full_rows: np.ndarray, full_cols: np.ndarray) -> dict:
+                  full_rows: np.ndarray, full_cols: np.ndarray,
+                  shadow_of: np.ndarray | None = None) -> dict:
         """``cache`` (:meth:`_own_union`) with the node blocks of the new node pairs
         ``add_keys`` merged in: the same union and slots as built afresh, found from the
         new blocks' entries alone. The kept pairs are in the order they came, the new ones
-        after them, so that the kept slots stay a prefix."""
+        after them, so that the kept slots stay a prefix. With ``shadow_of`` (the kept
+        entries of ``add_keys``, pairs already kept), the pairs' rows and columns grow to
+        ``full_rows``, ``full_cols``: only their entries not yet in the union are added,
+        as shadow pairs that take the kept pair's block (:meth:`_with_own_hessian`)."""
         size = cache["size"]
         rows, cols, valid = self._block_entries(node_dofs, add_keys, full_rows, full_cols)
+        if shadow_of is not None:
+            kept_valid = self._block_entries(node_dofs, add_keys, cache["full_rows"][shadow_of],
+                                             cache["full_cols"][shadow_of])[2]
+            valid = valid & ~kept_valid
         lin = cols.ravel()[valid].astype(np.int64) * size + rows.ravel()[valid]
         lin_u = cache["lin_u"]
         fresh = np.unique(lin)
@@ -502,12 +518,19 @@ class RodSystem:
         grown[~is_added] = lin_u
         old_to_new = np.flatnonzero(~is_added)
         keys = np.concatenate([cache["keys"], add_keys])
+        # stable: a shadow pair sorts after its kept pair, which _kept_at then finds
         order = np.argsort(keys, kind="stable")
+        full_r = np.concatenate([cache["full_rows"], full_rows])
+        full_c = np.concatenate([cache["full_cols"], full_cols])
+        shadow, shadow_src = cache["shadow"], cache["shadow_src"]
+        if shadow_of is not None:
+            full_r[shadow_of], full_c[shadow_of] = full_rows, full_cols
+            shadow = np.concatenate([shadow, cache["keys"].size + np.arange(add_keys.size)])
+            shadow_src = np.concatenate([shadow_src, shadow_of])
         dtype = cache["indices_u"].dtype
         counts = np.bincount(grown // size, minlength=size)
         cache = dict(cache, keys=keys, sort=order, sorted_keys=keys[order],
-                     full_rows=np.concatenate([cache["full_rows"], full_rows]),
-                     full_cols=np.concatenate([cache["full_cols"], full_cols]),
+                     full_rows=full_r, full_cols=full_c, shadow=shadow, shadow_src=shadow_src,
                      valid=np.concatenate([cache["valid"], valid]),
                      slot_e=old_to_new[cache["slot_e"]],
                      slot_t=np.concatenate([old_to_new[cache["slot_t"]],
