@@ -27,6 +27,7 @@ from tightknot.rods.proximity import ProximityCheck
 from tightknot.rods.staging import Output
 from tightknot.rods.state import State
 from tightknot.rods.term import BlockHessian, EnergyTerm
+from tightknot.solvers.kept_union import merge_sorted, place_blocks
 from tightknot.solvers.linear import LowRankHessian, SparseDirect
 from tightknot.solvers.pardiso import section_linear
 from tightknot.solvers.pattern import ContactPattern, SparsePattern
@@ -403,19 +404,17 @@ class RodSystem:
         rows_in, cols_in = own.masks()
         if same_base:
             at, found = _kept_at(cache, new_keys)
-            grown = (found & ((rows_in & ~cache["full_rows"][at])
-                              | (cols_in & ~cache["full_cols"][at])))
-            if grown.any():
-                # kept blocks gain rows or columns: their new entries join the union as
-                # shadow pairs (the same node pair, only those entries)
-                cache = self._own_grow(cache, own.node_dofs, new_keys[grown],
-                                       rows_in[grown] | cache["full_rows"][at[grown]],
-                                       cols_in[grown] | cache["full_cols"][at[grown]],
-                                       shadow_of=at[grown])
-            if not found.all():
-                cache = self._own_grow(cache, own.node_dofs, new_keys[~found],
-                                       rows_in[~found], cols_in[~found])
+            kept_r, kept_c = cache["full_rows"][at], cache["full_cols"][at]
+            grown = found & ((rows_in & ~kept_r) | (cols_in & ~kept_c))
             if grown.any() or not found.all():
+                # kept blocks that gain rows or columns (their new entries join the union
+                # as shadow pairs: the same node pair, only those entries), then new pairs
+                add = np.concatenate([np.flatnonzero(grown), np.flatnonzero(~found)])
+                old = found[add]
+                cache = self._own_grow(cache, own.node_dofs, new_keys[add],
+                                       rows_in[add] | (kept_r[add] & old),
+                                       cols_in[add] | (kept_c[add] & old),
+                                       np.where(old, at[add], -1))
                 at, _ = _kept_at(cache, new_keys)
         if not same_base:
             if cache is None:
@@ -431,15 +430,16 @@ class RodSystem:
                 full_c[new_at] |= cols_in
             cache = self._own_union(hmat, own.node_dofs, keys, full_r, full_c)
             at, _ = _kept_at(cache, new_keys)
-        b = own.blocks.shape[1]
-        blocks = np.zeros((cache["keys"].size, b, b))
-        blocks[at] = own.blocks
+        # which of own's blocks each kept pair takes (-1: none); a shadow pair its kept
+        # pair's
+        source = np.full(cache["keys"].size, -1, dtype=np.int64)
+        source[at] = np.arange(at.size)
         if cache["shadow"].size:
-            blocks[cache["shadow"]] = blocks[cache["shadow_src"]]
+            source[cache["shadow"]] = source[cache["shadow_src"]]
         data = np.zeros(cache["indices_u"].size)
         data[cache["slot_e"]] = hmat.data
         # each (row, column) entry belongs to one node pair: the slots are distinct
-        data[cache["slot_t"]] += blocks.ravel()[cache["valid"]]
+        place_blocks(data, cache["valid"], cache["slot_t"], source, own.blocks)
         size = cache["size"]
         return sp.csc_matrix((data, cache["indices_u"], cache["indptr_u"]), shape=(size, size))
 
@@ -491,44 +491,46 @@ class RodSystem:
     def _own_grow(self, cache: dict, node_dofs: np.ndarray, add_keys: np.ndarray,
                   full_rows: np.ndarray, full_cols: np.ndarray,
                   shadow_of: np.ndarray | None = None) -> dict:
-        """``cache`` (:meth:`_own_union`) with the node blocks of the new node pairs
+        """``cache`` (:meth:`_own_union`) with the node blocks of the node pairs
         ``add_keys`` merged in: the same union and slots as built afresh, found from the
         new blocks' entries alone. The kept pairs are in the order they came, the new ones
-        after them, so that the kept slots stay a prefix. With ``shadow_of`` (the kept
-        entries of ``add_keys``, pairs already kept), the pairs' rows and columns grow to
-        ``full_rows``, ``full_cols``: only their entries not yet in the union are added,
-        as shadow pairs that take the kept pair's block (:meth:`_with_own_hessian`)."""
+        after them, so that the kept slots stay a prefix. ``shadow_of``: for each of
+        ``add_keys``, its entry among the kept pairs where it is kept already (-1: a new
+        pair; None: all new). A kept pair's rows and columns grow to ``full_rows``,
+        ``full_cols``: only its entries not yet in the union are added, as a shadow pair
+        that takes the kept pair's block (:meth:`_with_own_hessian`)."""
         size = cache["size"]
         rows, cols, valid = self._block_entries(node_dofs, add_keys, full_rows, full_cols)
-        if shadow_of is not None:
-            kept_valid = self._block_entries(node_dofs, add_keys, cache["full_rows"][shadow_of],
-                                             cache["full_cols"][shadow_of])[2]
-            valid = valid & ~kept_valid
+        shadow_of = (np.full(add_keys.size, -1, dtype=np.int64) if shadow_of is None
+                     else np.asarray(shadow_of, dtype=np.int64))
+        is_shadow = shadow_of >= 0
+        if is_shadow.any():
+            sh = shadow_of[is_shadow]
+            kept_valid = self._block_entries(node_dofs, add_keys[is_shadow],
+                                             cache["full_rows"][sh], cache["full_cols"][sh])[2]
+            per_pair = valid.reshape(add_keys.size, -1)
+            per_pair[is_shadow] &= ~kept_valid.reshape(sh.size, -1)
+            valid = per_pair.ravel()
         lin = cols.ravel()[valid].astype(np.int64) * size + rows.ravel()[valid]
         lin_u = cache["lin_u"]
         fresh = np.unique(lin)
         pos = np.searchsorted(lin_u, fresh)
         present = lin_u[np.minimum(pos, lin_u.size - 1)] == fresh
         added = fresh[~present]
-        ins = pos[~present] + np.arange(added.size)  # their places in the grown union
-        is_added = np.zeros(lin_u.size + added.size, dtype=bool)
-        is_added[ins] = True
-        grown = np.empty(is_added.size, dtype=np.int64)
-        grown[ins] = added
-        grown[~is_added] = lin_u
-        old_to_new = np.flatnonzero(~is_added)
+        dtype = cache["indices_u"].dtype
+        grown, old_to_new, indices_u = merge_sorted(lin_u, added, size, dtype)
         keys = np.concatenate([cache["keys"], add_keys])
         # stable: a shadow pair sorts after its kept pair, which _kept_at then finds
         order = np.argsort(keys, kind="stable")
         full_r = np.concatenate([cache["full_rows"], full_rows])
         full_c = np.concatenate([cache["full_cols"], full_cols])
         shadow, shadow_src = cache["shadow"], cache["shadow_src"]
-        if shadow_of is not None:
-            full_r[shadow_of], full_c[shadow_of] = full_rows, full_cols
-            shadow = np.concatenate([shadow, cache["keys"].size + np.arange(add_keys.size)])
-            shadow_src = np.concatenate([shadow_src, shadow_of])
-        dtype = cache["indices_u"].dtype
-        counts = np.bincount(grown // size, minlength=size)
+        if is_shadow.any():
+            sh = shadow_of[is_shadow]
+            full_r[sh], full_c[sh] = full_rows[is_shadow], full_cols[is_shadow]
+            shadow = np.concatenate([shadow, cache["keys"].size + np.flatnonzero(is_shadow)])
+            shadow_src = np.concatenate([shadow_src, sh])
+        counts = np.diff(cache["indptr_u"]) + np.bincount(added // size, minlength=size)
         cache = dict(cache, keys=keys, sort=order, sorted_keys=keys[order],
                      full_rows=full_r, full_cols=full_c, shadow=shadow, shadow_src=shadow_src,
                      valid=np.concatenate([cache["valid"], valid]),
@@ -537,7 +539,7 @@ class RodSystem:
                                             np.searchsorted(grown, lin)]),
                      lin_u=grown,
                      indptr_u=np.concatenate([[0], np.cumsum(counts)]).astype(dtype),
-                     indices_u=(grown % size).astype(dtype))
+                     indices_u=indices_u)
         self._own_pattern = cache
         return cache
 
