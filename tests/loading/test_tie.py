@@ -173,3 +173,42 @@ def test_a_pass_through_between_iterates_is_named() -> None:
     assert knot_type_of(scene, moved) == "0_1"
     why = topology_change(scene, [x, moved], scene.model.edge_rest_length, knot_type_of)
     assert "passed through itself" in why and "edges" in why
+
+
+
+def test_a_search_without_settling_steps_from_the_held_knot(monkeypatch) -> None:
+    # The sections' route searches the force from the tied knot whose end is held
+    # (tightknot/loading/pull.py: _seek(settle=False)): its first solve is at the
+    # search's first force, not the dead-load equilibrium at the force the end carries; a
+    # knot already within the tolerance is still brought to that equilibrium, so that the
+    # result is one under a dead load.
+    import dataclasses
+
+    from tightknot.loading.levels import LevelPath, SearchOptions
+    from tightknot.loading.pull import _seek, knot_length
+    from tightknot.loading.tie import system_at
+    from tightknot.solvers.program import Program
+
+    scene = open_trefoil(0.125, nodes=90)
+    tied = tie(scene, tighten_steps=20).run()
+    assert tied.converged, tied.failure
+    carried = end_reaction(tied.system)
+    lam = knot_length(scene, tied.system)
+    forces: list[float] = []
+    solve = LevelPath.solve
+
+    def recorded(self, value):
+        forces.append(value)
+        return (yield from solve(self, value))
+
+    monkeypatch.setattr(LevelPath, "solve", recorded)
+    search = SearchOptions(tolerance=0.1, step_ratio=1.15, max_steps=60, retries=3,
+                           refine="bisection")
+    for target, settled in ((lam - 0.5, False), (lam + 0.05, True)):
+        forces.clear()
+        start = dataclasses.replace(tied, system=system_at(scene, tied.system))
+        res = Program(_seek(scene, start, target, search, 1e-8, None, settle=False),
+                      "seek").run()
+        assert res.converged, res.failure
+        assert abs(knot_length(scene, res.system) - target) <= 0.1
+        assert forces and (forces[0] == carried) == settled
