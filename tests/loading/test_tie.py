@@ -212,3 +212,17 @@ def test_a_search_without_settling_steps_from_the_held_knot(monkeypatch) -> None
         assert res.converged, res.failure
         assert abs(knot_length(scene, res.system) - target) <= 0.1
         assert forces and (forces[0] == carried) == settled
+
+
+def test_the_last_slope_of_a_search() -> None:
+    # The final route's search after the sections join steps by the slope of the compliant
+    # search's last two equilibria (tightknot/loading/pull.py: _last_slope), in log force.
+    import math
+
+    from tightknot.loading.pull import _last_slope
+
+    pts = [(math.log(1.72), 15.23), (math.log(1.85), 14.89), (math.log(1.79), 15.07)]
+    assert _last_slope(pts) == pytest.approx((15.07 - 14.89) / math.log(1.79 / 1.85))
+    assert _last_slope(pts[:1]) is None  # one equilibrium
+    assert _last_slope([pts[0], pts[0]]) is None  # one force
+    assert _last_slope([pts[0], (math.log(1.85), 15.5)]) is None  # rising: no secant

@@ -157,15 +157,31 @@ def _tie_to_lambda(scene: KnotScene, via: KnotScene, target: float, search: Sear
             return res
         return (yield from _seek(scene, res, target, dataclasses.replace(search, secant=True),
                                  residual_tol, hook, slope=slope, settle=False))
-    res = yield from _seek(via, res, target, search, residual_tol, hook)
+    measured: list[tuple[float, float]] = []
+    res = yield from _seek(via, res, target, search, residual_tol, hook, measured=measured)
     if via is scene or not res.converged:
         return res
     res = yield from section_finish(scene, dataclasses.replace(res, section_path="final"),
                                     residual_tol, hook)
     if not res.converged:
         return res
-    # (the sections' equilibrium is one under the pull already: no first solve)
-    return (yield from _seek(scene, res, target, search, residual_tol, hook, pulled=True))
+    # (the sections' equilibrium is one under the pull already: no first solve) The
+    # sections move Lambda_OC off the target: the search steps back by a secant on the
+    # slope of the compliant search's last two equilibria, where it pulls harder.
+    slope = _last_slope(measured)
+    return (yield from _seek(scene, res, target,
+                             dataclasses.replace(search, secant=slope is not None),
+                             residual_tol, hook, pulled=True, slope=slope))
+
+
+def _last_slope(measured: list[tuple[float, float]]) -> float | None:
+    """dLambda_OC/dlog(F) between the last two (log F, Lambda_OC) of a search, None where
+    there are fewer, at one force, or Lambda_OC does not fall as the force grows."""
+    if len(measured) < 2 or measured[-1][0] == measured[-2][0]:
+        return None
+    (f0, lam0), (f1, lam1) = measured[-2:]
+    slope = (lam1 - lam0) / (f1 - f0)
+    return slope if math.isfinite(slope) and slope < 0 else None
 
 
 def _compliant_slope(scene: KnotScene, res: TieResult, target: float, ratio: float,
@@ -191,13 +207,15 @@ def _compliant_slope(scene: KnotScene, res: TieResult, target: float, ratio: flo
 
 def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions,
           residual_tol: float, hook: StepHook | None, pulled: bool = False,
-          slope: float | None = None, settle: bool = True) -> Coroutine[TieResult]:
+          slope: float | None = None, settle: bool = True,
+          measured: list[tuple[float, float]] | None = None) -> Coroutine[TieResult]:
     """From ``res`` (an open knot of ``scene`` in equilibrium), the pull whose Lambda_OC is
     ``target``: first the equilibrium under the force the end carries now, centred on its
     rod (unless ``pulled``: ``res`` is one under that dead force already; without
     ``settle`` only where ``res``'s Lambda_OC is within the tolerance already), then the
     force searched (``search``; ``slope``: :meth:`~tightknot.loading.levels.LevelPath.
-    seek`'s first estimate of dLambda_OC/dlog F)."""
+    seek`'s first estimate of dLambda_OC/dlog F). ``measured``: filled with the search's
+    (log F, Lambda_OC) of each equilibrium it measured, in order."""
     start = time.perf_counter()
     types = list(res.knot_types)
     # Every force is one static solve: the search itself retries a failed step.
@@ -220,4 +238,6 @@ def _seek(scene: KnotScene, res: TieResult, target: float, search: SearchOptions
         if why:
             return done(why)
     why = yield from path.seek(target, lambda s: knot_length(scene, s), search, slope)
+    if measured is not None:
+        measured.extend(path.history)
     return done(why)
