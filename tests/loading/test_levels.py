@@ -236,16 +236,21 @@ def _inverse_stretch_at(force: float) -> float:
 
 
 def test_a_given_slope_makes_the_first_secant_step() -> None:
-    # The slope of 1/lam in log F over the step to the target: the first step lands on it,
-    # where the fixed first step (1.15) overshoots and the bracket is searched.
+    # The slope of 1/lam in log F over the step to the target: the first step lands within
+    # the tolerance, where the fixed first step (1.15) overshoots and the bracket is
+    # searched. A given slope's step aims half the tolerance past the target (a cheaper
+    # model's slope has overestimated the response): log F moves by that over the slope.
     target_force = 2.0 * 1.08
     target = _inverse_stretch_at(target_force)
     slope = (target - _inverse_stretch_at(2.0)) / math.log(1.08)
-    search = SearchOptions(tolerance=1e-6, secant=True, retries=3, refine="bisection")
+    tol = 1e-6
+    search = SearchOptions(tolerance=tol, secant=True, retries=3, refine="bisection")
     hinted = _path(ONE)
     assert _run(hinted.seek(target, _inverse_stretch, search, slope)) == ""
     assert hinted.solves == 2  # the start and the one secant step
-    assert hinted.level == pytest.approx(target_force, rel=1e-9)
+    assert hinted.level == pytest.approx(target_force * math.exp(-0.5 * tol / slope),
+                                         rel=1e-9)
+    assert hinted.level > target_force  # past the target: Lambda_OC falls with F
     plain = _path(ONE)
     assert _run(plain.seek(target, _inverse_stretch, search)) == ""
     assert plain.solves > 2
