@@ -179,8 +179,8 @@ def _last_slope(measured: list[tuple[float, float]]) -> float | None:
     there are fewer, at one force, or Lambda_OC does not fall as the force grows."""
     if len(measured) < 2 or measured[-1][0] == measured[-2][0]:
         return None
-    (f0, lam0), (f1, lam1) = measured[-2:]
-    slope = (lam1 - lam0) / (f1 - f0)
+    (log_f0, lam0), (log_f1, lam1) = measured[-2:]
+    slope = (lam1 - lam0) / (log_f1 - log_f0)
     return slope if math.isfinite(slope) and slope < 0 else None
 
 

@@ -5,9 +5,10 @@ pull-back) keeps the union of the rods' pattern and those blocks through a load 
 sorted linear indices ``column * size + row``, with each block entry's slot in it. Two
 steps of that bookkeeping run on every Newton evaluation and walk the whole union: placing
 the blocks' values into the union's data, and merging the entries of new node pairs into
-the union. Each is one pass here (numba), where whole-array numpy operations made several
-passes over a million entries. Neither adds two numbers that the numpy form did not add,
-in the same way, so the matrices are the same bit for bit.
+the union. Each is one pass here (numba); in whole-array numpy operations each takes
+several passes over a million entries. Every slot of the union receives at most one block
+entry, added to the rods' entry there, so the loops' order leaves the matrix unchanged to
+the bit.
 """
 
 from __future__ import annotations
@@ -65,8 +66,8 @@ def place_blocks(data: np.ndarray, valid: np.ndarray, slots: np.ndarray, source:
     """Add node blocks into a kept union's ``data`` in place: for kept pair k, the entries
     of ``blocks[source[k]]`` (B, b, b) that ``valid`` (flat over the kept pairs' b x b
     entries) keeps, in order, at ``slots`` (one per kept entry, all distinct); a pair with
-    ``source`` -1 adds zeros (the numpy form's zero blocks, so that a stored -0.0 turns to
-    +0.0 as it did)."""
+    ``source`` -1 adds zeros (a kept pair without a block this evaluation is a zero block:
+    a stored -0.0 there becomes +0.0)."""
     b = blocks.shape[1]
     flat = np.ascontiguousarray(blocks.reshape(blocks.shape[0], b * b), dtype=np.float64)
     _place(data, np.ascontiguousarray(valid), np.ascontiguousarray(slots, dtype=np.int64),
