@@ -410,11 +410,11 @@ class RodSystem:
                 # kept blocks that gain rows or columns (their new entries join the union
                 # as shadow pairs: the same node pair, only those entries), then new pairs
                 add = np.concatenate([np.flatnonzero(grown), np.flatnonzero(~found)])
-                old = found[add]
+                kept = found[add]
                 cache = self._own_grow(cache, own.node_dofs, new_keys[add],
-                                       rows_in[add] | (kept_r[add] & old),
-                                       cols_in[add] | (kept_c[add] & old),
-                                       np.where(old, at[add], -1))
+                                       rows_in[add] | (kept_r[add] & kept),
+                                       cols_in[add] | (kept_c[add] & kept),
+                                       np.where(kept, at[add], -1))
                 at, _ = _kept_at(cache, new_keys)
         if not same_base:
             if cache is None:
@@ -489,20 +489,19 @@ class RodSystem:
         return cache
 
     def _own_grow(self, cache: dict, node_dofs: np.ndarray, add_keys: np.ndarray,
-                  full_rows: np.ndarray, full_cols: np.ndarray,
-                  shadow_of: np.ndarray | None = None) -> dict:
+                  full_rows: np.ndarray, full_cols: np.ndarray, shadow_of: np.ndarray
+                  ) -> dict:
         """``cache`` (:meth:`_own_union`) with the node blocks of the node pairs
         ``add_keys`` merged in: the same union and slots as built afresh, found from the
         new blocks' entries alone. The kept pairs are in the order they came, the new ones
         after them, so that the kept slots stay a prefix. ``shadow_of``: for each of
         ``add_keys``, its entry among the kept pairs where it is kept already (-1: a new
-        pair; None: all new). A kept pair's rows and columns grow to ``full_rows``,
+        pair). A kept pair's rows and columns grow to ``full_rows``,
         ``full_cols``: only its entries not yet in the union are added, as a shadow pair
         that takes the kept pair's block (:meth:`_with_own_hessian`)."""
         size = cache["size"]
         rows, cols, valid = self._block_entries(node_dofs, add_keys, full_rows, full_cols)
-        shadow_of = (np.full(add_keys.size, -1, dtype=np.int64) if shadow_of is None
-                     else np.asarray(shadow_of, dtype=np.int64))
+        shadow_of = np.asarray(shadow_of, dtype=np.int64)
         is_shadow = shadow_of >= 0
         if is_shadow.any():
             sh = shadow_of[is_shadow]
