@@ -203,11 +203,12 @@ def test_auto_pulls_an_open_knot_with_its_sections() -> None:
 
 def test_sections_thinner_than_the_fem_judged_are_said(sectioned_run) -> None:
     """A sectioned run whose sections' area falls below the smallest A/A0 the FEM
-    cross-check judged (0.69, the wrap's deepest level) says so in its summary's
-    warnings; the tied trefoil (A/A0 0.92) does not."""
+    judged (0.66, the rigid wrap's deepest level within the approach limit,
+    tests/fem/test_section_area_range.py) says so in its summary's warnings; the tied
+    trefoil (A/A0 0.92) does not."""
     scene, run = sectioned_run
     cal = scene.contact.calibration
-    assert cal.judged_area_ratio == pytest.approx(0.6927)
+    assert 0.43 < cal.judged_area_ratio < 0.92
     st = run.result.system.state
     rep = contact_report(scene.contact, st.x, run.result.system.rest, st)
     ok = calibration_range(scene, rep, st.x, run.result.system.rest)
@@ -215,7 +216,8 @@ def test_sections_thinner_than_the_fem_judged_are_said(sectioned_run) -> None:
     thin = dataclasses.replace(rep, area_ratio=np.minimum(rep.area_ratio, 0.43))
     out = calibration_range(scene, thin, st.x, run.result.system.rest)
     assert out["outside_calibrated_range"]
-    assert any("A/A0 = 0.43, below the 0.693" in w for w in out["warnings"])
+    assert any(f"A/A0 = 0.43, below the {cal.judged_area_ratio:.3g}" in w
+               for w in out["warnings"])
 
 
 def _lost_solve(real, system, newton_options):

@@ -98,17 +98,19 @@ def fem_width_fraction(step: dict[str, Any], scene: str) -> float | None:
     return None if b is None else 2.0 * b / perimeter
 
 def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str, str],
-             kappa_key: str | None, width_scene: str | None = None) -> dict[str, Any]:
-    """Per-level comparison up to ``APPROACH_LIMIT`` (gated on the FEM's
-    ``approach_over_d0``). ``force_keys``: (FEM key, rod key) of the compared force;
-    ``kappa_key``: the FEM key of the axis curvature compared with the rod's
-    ``kappa_d0_mid`` (None: not compared); ``width_scene``: compare the mid section's
+             kappa_key: str | None, width_scene: str | None = None,
+             limit: float = APPROACH_LIMIT) -> dict[str, Any]:
+    """Per-level comparison up to an approach of ``limit`` D0 (gated on the FEM's
+    ``approach_over_d0``; default ``APPROACH_LIMIT``, the targets' range).
+    ``force_keys``: (FEM key, rod key) of the compared force; ``kappa_key``: the FEM
+    key of the axis curvature compared with the rod's ``kappa_d0_mid`` (None: not
+    compared); ``width_scene``: compare the mid section's
     contact width fraction (the rod's ``contact_width_fraction_mid``) with the FEM's
     (:func:`fem_width_fraction` of that scene), None: not compared."""
     fem_force, rod_force = force_keys
     rows = []
     for f, r in zip(fem_steps, rod_steps, strict=True):
-        if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9:
+        if f["approach_over_d0"] > limit + 1e-9:
             continue
         row = {
             "approach_over_d0": f["approach_over_d0"],
