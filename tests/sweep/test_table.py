@@ -38,6 +38,8 @@ def test_one_row_per_level_with_every_parameter_and_default(force_store: Path) -
         s = level["summary"]
         assert row["reached"] is True and row["pull_force_N"] == level["target"]
         assert row["lambda_oc"] == s["lambda_oc"] and row["min_area_ratio"] == s["min_area_ratio"]
+        assert row["outside_calibrated_range"] is s["outside_calibrated_range"]
+        assert row["warnings"] == "; ".join(s["warnings"])
         x = s["centerline_m"]
         assert row["end_to_end_m"] == math.dist(x[0], x[-1])
     # A harder pull: a longer rod, a shorter knot.
@@ -78,7 +80,9 @@ def test_a_missed_level_is_a_marked_row(tmp_path: Path) -> None:
     # A synthetic record (the file format only): the first level missed, the second reached.
     case = grid({"knot": "open", "nodes": 90, "pull_force": [0.3, 3.0]})[0]
     summary = {"knot_type": "3_1", "pull_force_N": 3.0, "lambda_oc": 12.0, "stretch": 1.07,
-               "centerline_m": [[0, 0, 0], [0.1, 0, 0]], "min_area_ratio": 0.87}
+               "centerline_m": [[0, 0, 0], [0.1, 0, 0]], "min_area_ratio": 0.87,
+               "outside_calibrated_range": True,
+               "warnings": ["the contact reaches w/D0 = 0.2", "a crossing reaches w/D0 = 0.2"]}
     levels = [{"kind": "pull_force", "target": 0.3, "reached": False, "failure": "slipped",
                "pull_force_N": 1.4, "lambda_oc": None, "newton_iterations": 9, "solves": 3,
                "wall_time_s": 0.1, "summary": None},
@@ -93,6 +97,11 @@ def test_a_missed_level_is_a_marked_row(tmp_path: Path) -> None:
     assert [(r["reached"], r["level_failure"]) for r in rows] == [(False, "slipped"),
                                                                     (True, None)]
     assert rows[0]["stretch"] is None and rows[0]["pull_force_N"] == 1.4
+    # the level outside its model's range says so in its row
+    assert rows[0]["outside_calibrated_range"] is None and rows[0]["warnings"] is None
+    assert rows[1]["outside_calibrated_range"] is True
+    assert rows[1]["warnings"] == ("the contact reaches w/D0 = 0.2; a crossing reaches w/D0 "
+                                   "= 0.2")
     assert rows[1]["end_to_end_m"] == pytest.approx(0.1, abs=1e-15)  # exact up to rounding
     assert write_table(store, tmp_path / "t.csv") == 2
 

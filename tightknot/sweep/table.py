@@ -20,11 +20,14 @@ from typing import Any
 from tightknot.atomic import atomic_open, write_text_atomic
 from tightknot.sweep.store import Store
 
-#: Measurements of a level (or a closed knot) copied from its summary, in column order.
+#: Measurements of a level (or a closed knot) copied from its summary, in column order;
+#: ``outside_calibrated_range`` and ``warnings`` (joined by "; ") say where a row leaves
+#: the range its contact model was calibrated or judged in (the summary's).
 MEASURES = ("knot_type", "pull_force_N", "lambda_oc", "end_to_end_m", "stretch", "L_over_D",
             "min_gap_over_D0", "min_area_ratio", "max_contact_width_fraction",
             "max_pressure_over_E", "kappa_D0_max", "kappa_D0_min", "max_approach_w_over_D0",
-            "nodes", "newton_iterations", "wall_time_s")
+            "outside_calibrated_range", "warnings", "nodes", "newton_iterations",
+            "wall_time_s")
 #: Columns of every row before the parameters and the measures.
 HEAD = ("case_id", "status", "knot", "level_kind", "level_index", "level_target", "reached",
         "level_failure")
@@ -47,6 +50,8 @@ def _measures(summary: Mapping[str, Any] | None) -> dict[str, Any]:
     s = summary or {}
     out = {k: s.get(k) for k in MEASURES}
     out["end_to_end_m"] = _end_to_end(s) if s else None
+    if out["warnings"] is not None:
+        out["warnings"] = "; ".join(out["warnings"])
     return out
 
 
