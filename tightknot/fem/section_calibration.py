@@ -133,9 +133,8 @@ def area_range(fem_wrap: dict[str, Any], section: Any = None,
     settings when None) in the wrap at the tensions of the FEM wrap result ``fem_wrap``,
     compared as the cross-check compares it (targets and approach limit of
     :mod:`tightknot.fem.crosscheck_targets`; the levels past the limit are reported, not
-    judged). ``spread``: FEM wrap results of other meshes
-    at the same tensions (a mesh's run may stop early), reported at the judged level
-    beside the comparison. Returns the record :func:`write_area_range` stores, with
+    judged). ``spread``: FEM wrap results of other meshes at the same tensions (a mesh's
+    run may stop early), reported at the judged level beside the comparison. Returns the record :func:`write_area_range` stores, with
     ``judged_area_ratio`` (None when no level meets every target)."""
     from tightknot.contact.sectioned import SectionSettings
 
@@ -146,6 +145,7 @@ def area_range(fem_wrap: dict[str, Any], section: Any = None,
 
     section = section or SectionSettings()
     rod = _rod_wrap_like(fem_wrap, rod_wrap_sectioned, section=section)
+
     def compared(limit: float) -> list[dict[str, Any]]:
         return _compare(fem_wrap["steps"], rod["steps"],
                         ("force_per_length_mid_nominal", "force_per_length_mid"),
