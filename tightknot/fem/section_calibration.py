@@ -134,8 +134,9 @@ def area_range(fem_wrap: dict[str, Any], section: Any = None,
     compared as the cross-check compares it (targets and approach limit of
     :mod:`tightknot.fem.crosscheck_targets`; the levels past the limit are reported, not
     judged). ``spread``: FEM wrap results of other meshes at the same tensions (a mesh's
-    run may stop early), reported at the judged level beside the comparison. Returns the record :func:`write_area_range` stores, with
-    ``judged_area_ratio`` (None when no level meets every target)."""
+    run may stop early), reported at the judged level beside the comparison. Returns the
+    record :func:`write_area_range` stores, with ``judged_area_ratio`` (None when no level
+    meets every target)."""
     from tightknot.contact.sectioned import SectionSettings
 
     from .crosscheck import _compare, _rod_wrap_like
