@@ -85,7 +85,8 @@ def test_tie_run_folder_holds_every_output(closed_run: Path) -> None:
     for key in ("alexander_at_minus1", "newton_iterations", "wall_time_s", "stretch",
                 "L_over_D", "min_gap_over_D0", "max_pressure_over_E", "min_area_ratio",
                 "max_contact_width_fraction", "s", "kappa", "rho", "z", "area_ratio",
-                "contact_width_fraction", "contact_s", "contact_sigma", "load_steps"):
+                "contact_width_fraction", "peak_pressure_over_E", "contact_s",
+                "contact_sigma", "load_steps"):
         assert key in data, key
     cfg = json.loads((closed_run / "config.json").read_text())
     assert cfg["knot"] == "closed" and cfg["nodes"] == 60 and cfg["color_by"] == "kappa_D0"

@@ -22,7 +22,9 @@ def test_figures(tmp_path):
         opens[lab] = analyze_centerline(pts, 1.0, False, contact_tol=0.1)
     lc = {k: np.zeros(len(r["s"])) for k, r in opens.items()}
     area = {k: np.ones(len(r["s"])) for k, r in opens.items()}
-    plot_open_knots(opens, tmp_path / "open.png", contact_width=lc, area_ratio=area)
+    press = {k: np.linspace(0.0, 0.9, len(r["s"])) for k, r in opens.items()}
+    plot_open_knots(opens, tmp_path / "open.png", contact_width=lc, area_ratio=area,
+                    pressure=press, judged_area_ratio=0.66)
     for name in ("profiles.png", "contact.png", "open.png"):
         data = (tmp_path / name).read_bytes()
         assert data.startswith(PNG) and data.rstrip().endswith(b"IEND\xaeB`\x82")

@@ -202,6 +202,10 @@ def summarise(scene: KnotScene, res: TieResult, rep: dict, contact: ContactRepor
         "kappa": np.asarray(rep["kappa_D0"]).tolist(),
         "area_ratio": contact.area_ratio.tolist(),
         "contact_width_fraction": contact.contact_width_fraction.tolist(),
+        # the largest contact pressure over E at each vertex's section (null for a rigid
+        # tube, which has none)
+        "peak_pressure_over_E": (None if scene.contact.law.rigid
+                                 else contact.peak_pressure_over_E.tolist()),
         "contact_s": np.asarray(rep["contact_s"]).tolist(),
         "contact_sigma": np.asarray(rep["contact_sigma"]).tolist(),
         "centerline_m": x.tolist(),
@@ -453,7 +457,9 @@ def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> 
                                      knot=knot_title(True, kt))
             paths += [p1, p2]
     if opened:
-        reps, lcs, areas = {}, {}, {}
+        reps, lcs, areas, press = {}, {}, {}, {}
+        judged = [r.scene.contact.calibration.judged_area_ratio for r in opened
+                  if isinstance(r.scene.contact, SectionedLayer)]
         for r in opened:
             lab = f"L0 = {r.scene.rest_length * 1e3:.0f} mm, F = {r.result.pull_force_N:.3g} N"
             order = np.asarray(r.report.get("vertex_order", np.arange(len(r.contact.area_ratio))),
@@ -461,7 +467,10 @@ def draw_figures(runs: list[KnotRun], folder: Path, tube: str | None = None) -> 
             reps[lab] = r.report
             lcs[lab] = r.contact.contact_width_fraction[order]
             areas[lab] = r.contact.area_ratio[order]
+            if not r.scene.contact.law.rigid:
+                press[lab] = r.contact.peak_pressure_over_E[order]
         p = folder / "open_knots.png"
-        figures.plot_open_knots(reps, p, contact_width=lcs, area_ratio=areas)
+        figures.plot_open_knots(reps, p, contact_width=lcs, area_ratio=areas, pressure=press,
+                                judged_area_ratio=max(judged) if judged else None)
         paths.append(p)
     return paths

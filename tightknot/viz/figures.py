@@ -119,15 +119,21 @@ def plot_open_knots(
     path: str | os.PathLike[str],
     contact_width: Mapping[str, Sequence[float]] | None = None,
     area_ratio: Mapping[str, Sequence[float]] | None = None,
+    pressure: Mapping[str, Sequence[float]] | None = None,
+    judged_area_ratio: float | None = None,
 ) -> None:
-    """Open knots at several tightness levels: kappa D0 (s), contact maps, L_c(s), A(s)/A0.
+    """Open knots at several tightness levels: kappa D0 (s), contact maps, L_c(s), A(s)/A0,
+    p_max(s)/E.
 
     ``reports``: label -> analyze_centerline dict of an open knot (e.g. "Lambda_OC = 15.0").
-    ``contact_width``/``area_ratio``: label -> per-vertex arrays (from the contact layer),
-    plotted against that report's s.
+    ``contact_width``/``area_ratio``/``pressure``: label -> per-vertex arrays (from the
+    contact layer: L_c, A/A0, the largest contact pressure over E), plotted against that
+    report's s. ``judged_area_ratio``: the smallest A/A0 at which the FEM judged the
+    sections, drawn on the A/A0 panel (below it a section is extrapolated).
     """
     extra = [(d, n) for d, n in ((contact_width, r"$L_c$ (contact width)"),
-                                  (area_ratio, r"$A/A_0$")) if d]
+                                  (area_ratio, r"$A/A_0$"),
+                                  (pressure, r"$p_{max}/E$")) if d]
     ncol = max(len(reports), 1)
     fig = plt.figure(figsize=(5 * max(ncol, 2), 4 + 2.5 * (1 + len(extra))))
     grid = fig.add_gridspec(2 + len(extra), ncol, height_ratios=[1, 1.6] + [1] * len(extra))
@@ -147,7 +153,11 @@ def plot_open_knots(
         for ax, (data, _) in zip(extra_axes, extra, strict=True):
             if lab in data:
                 ax.plot(rep["s"], data[lab], color=c, label=lab)
-    for ax, (_, ylab) in zip(extra_axes, extra, strict=True):
+    for ax, (data, ylab) in zip(extra_axes, extra, strict=True):
+        if data is area_ratio and judged_area_ratio is not None:
+            ax.axhline(judged_area_ratio, color="0.4", linestyle="--", linewidth=0.8,
+                       label=f"FEM-judged down to {judged_area_ratio:.3g}")
+            ax.legend(loc="lower right")
         ax.set_ylabel(ylab)
         ax.set_xlabel(r"$s = (S - S_{mid})/D_0$")
         ax.grid(alpha=0.3)
