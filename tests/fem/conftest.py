@@ -65,6 +65,18 @@ def soft_wrap_one_level():
 
 
 @pytest.fixture(scope="session")
+def soft_crossing_one_level():
+    """Two soft rods crossing: one coarse level at w = 0.0375 D0 per rod (the scene's
+    second level), no rigid run."""
+    pytest.importorskip("felupe")
+    pytest.importorskip("ipctk")
+    from tightknot.fem import run_scene
+
+    return run_scene("soft_crossing", mesh="coarse", max_approach_over_d0=0.075, steps=1,
+                     compare=False)
+
+
+@pytest.fixture(scope="session")
 def clasp_one_level():
     """The clasp: relaxation in the clamps and one coarse level at a pull of 0.7 D0 (the
     FEM's bends touch from about 0.4 D0 on, the rod model's, clamped at the same points,

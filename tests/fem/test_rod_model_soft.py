@@ -95,3 +95,31 @@ def test_clasp_rod_model_is_symmetric_and_pulls():
     # solver's tolerance leaves 1e-6)
     for pa, pb in zip(b["profile_a"], b["profile_b"], strict=True):
         assert pa["area_ratio"] == pytest.approx(pb["area_ratio"], rel=1e-6)
+
+
+def test_soft_crossing_stack_is_symmetric_and_its_neighbours_cross_alike():
+    """The soft crossing's stack (every rod pressed from both sides, each held on its
+    mid-plane): the rods above A push it as hard as those below (the force measured is
+    one crossing's), and rod B's crossing section thins as A's does (they differ only
+    by the stack's ends, six rods away)."""
+    from tightknot.fem.rod_model_soft import rod_soft_crossing, soft_crossing_scene
+
+    system, load, edges, levels = soft_crossing_scene(D0, E, 3.0)
+    assert levels == (0, 1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6)
+    load.hold(0.01 * D0)
+    system.set_load(1.0)
+    x = system.state.x
+    # held on their mid-planes, the neighbours 2 w closer on each side
+    assert x[system.model.rods[1].vertex_start:system.model.rods[2].vertex_start, 1] == \
+        pytest.approx(0.98 * D0, abs=1e-15)
+    with pytest.raises(ValueError, match="depth"):
+        soft_crossing_scene(D0, E, 3.0, depth=0)
+    ws = [0.006 * D0, 0.024 * D0]
+    for contact in ("sectioned", "compliant"):
+        res = rod_soft_crossing(ws, contact=contact)
+        for row in res["steps"]:
+            assert row["converged"] and row["force"] > 0.0
+            assert row["force_from_below"] == pytest.approx(row["force"], rel=1e-6)
+            assert row["area_ratio_mid_b"] == pytest.approx(row["area_ratio_mid"], abs=1e-3)
+        # a deeper crossing presses harder
+        assert res["steps"][1]["force"] > res["steps"][0]["force"]

@@ -56,8 +56,9 @@ def _scene_errors(scenes: dict[str, Any]) -> dict[str, Any]:
 
 def _soft_errors(report: dict[str, Any], level: str) -> dict[str, Any] | None:
     """The two-soft-rod scenes' errors of ``level`` in a report's ``soft_scenes`` (the soft
-    wrap's mid line load and the clasp's pull force, min and max over the compared load
-    levels, and the FEM over rod time of each), None where the report has none."""
+    wrap's mid line load, the clasp's pull force and the soft crossing's force, min and
+    max over the compared load levels, and the FEM over rod time of each), None where the
+    report has none."""
     entry = (report.get("soft_scenes") or {}).get("levels", {}).get(level)
     if entry is None:
         return None
@@ -159,9 +160,9 @@ def format_table(table: dict[str, Any]) -> str:
     lines = [f"contact levels against the FEM ({table['fem_mesh']} mesh, "
              f"{table['fem_wall_time_s']:.0f} s of FEM)",
              "| level | indent force | wrap line load | soft wrap line load | clasp force | "
-             "area, max [points] | wrap curvature, max | L_c, max | rod time [s] | "
-             "FEM / rod time | knots' time / compliant |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "soft crossing force | area, max [points] | wrap curvature, max | L_c, max | "
+             "rod time [s] | FEM / rod time | knots' time / compliant |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in table["rows"]:
         knots = row.get("knots")
         kt = ("n/a" if not knots or knots["time_ratio_to_compliant"] is None else
@@ -169,7 +170,7 @@ def format_table(table: dict[str, Any]) -> str:
               f"{knots['time_ratio_to_compliant'][1]:.2f}")
         if row["level"] == "rigid":
             lines.append(f"| rigid | n/a ({RIGID_REASON}) | n/a | n/a | n/a | n/a | n/a | n/a "
-                         f"| n/a | n/a | {kt} |")
+                         f"| n/a | n/a | n/a | {kt} |")
             continue
         area = max(row["indent_area_points_max"] or 0.0, row["wrap_area_points_max"] or 0.0)
         soft = row.get("soft") or {}
@@ -177,7 +178,8 @@ def format_table(table: dict[str, Any]) -> str:
         lines.append(
             f"| {name} | {_pct(row['indent_force_rel'])} | "
             f"{_pct(row['wrap_line_load_rel'])} | {_pct(soft.get('soft_wrap_force_rel'))} | "
-            f"{_pct(soft.get('clasp_force_rel'))} | {100 * area:.1f} | "
+            f"{_pct(soft.get('clasp_force_rel'))} | "
+            f"{_pct(soft.get('soft_crossing_force_rel'))} | {100 * area:.1f} | "
             f"{100 * (row['wrap_curvature_rel_max'] or 0.0):.1f} % | "
             + ("n/a" if row["width_fraction_max"] is None
                else f"{row['width_fraction_max']:.2f}")

@@ -76,7 +76,8 @@ def register(subparsers: Any) -> None:
                      help="soft_* only: skip the rigid counterpart (squeeze, indent or wrap)")
     fem.add_argument("--no-soft", action="store_true",
                      help="crosscheck only: leave out the two-soft-rod scenes (soft_wrap, "
-                          "clasp; on the medium mesh they take most of the time)")
+                          "clasp, soft_crossing; on the medium mesh they take most of the "
+                          "time)")
     fem.add_argument("--json", default=None, metavar="FILE",
                      help="write the result to FILE (atomically) instead of stdout")
     fem.add_argument("--contact", default="compliant", choices=("compliant", "sectioned"),

@@ -352,13 +352,14 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     the stretch that thins them, :class:`~tightknot.contact.sectioned.SectionSettings`;
     ``rod_edges_per_d0``: the sectioned rod scenes' resolution, docs/sectioned_level.md,
     "Resolution") and
-    compare them; with ``soft``, also the two-soft-rod scenes soft_wrap and clasp
-    (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, at every level of
+    compare them; with ``soft``, also the two-soft-rod scenes soft_wrap, clasp and
+    soft_crossing (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, at every level of
     :data:`~tightknot.fem.rod_model_soft.CONTACT_LEVELS` in a compliant report, at the
     sectioned level in a sectioned one; that level's ``passed`` part of the report's).
 
     ``fem_results`` may hold already computed FEM results (keys "indent", "wrap",
-    "soft_wrap", "clasp" and the soft scenes on the spread mesh, "soft_wrap@coarse" ...,
+    "soft_wrap", "clasp", "soft_crossing" and the soft scenes on the spread mesh,
+    "soft_wrap@coarse" ...,
     run with the default load levels, as a report's ``fem_results`` keeps them) to reuse;
     their own ``wall_time_s`` then enters the ratio. Returns the JSON-serialisable report
     (module docstring): per-scene comparisons, ``fem_over_rod_time_ratio``, ``passed``.

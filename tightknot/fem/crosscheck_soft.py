@@ -1,6 +1,6 @@
-"""The cross-check's two-soft-rod rows: the soft wrap's mid line load and the clasp's pull
-force, FEM against the rod model at each contact level, the FEM's mesh spread beside
-each comparison.
+"""The cross-check's two-soft-rod rows: the soft wrap's mid line load, the clasp's pull
+force and the soft crossing's force, FEM against the rod model at each contact level, the
+FEM's mesh spread beside each comparison.
 
 =====================  ==================================================  ==============
 quantity               compared                                            target
@@ -11,10 +11,16 @@ soft wrap line load    rod A's contact line load at the middle of the       |rel
 clasp force            the pull force at the same clamp travel [N]          |rel| <= 10 %
                        (and, a diagnostic, with the U's kinematics
                        matched, ``force_rel_kinematics_matched``: below)
-section area           A/A0 at the middle of the wrap / at the apex         |diff| <= 0.05
+soft crossing force    the force between the two crossing rods at the       |rel| <= 10 %
+                       same approach w per rod [N] (each rod in a stack
+                       pressed from both sides,
+                       :func:`tightknot.fem.rod_model_soft.soft_crossing_scene`)
+section area           A/A0 at the middle of the wrap / at the apex / at    |diff| <= 0.05
+                       the crossing
 curvature              soft wrap: kappa D0 of the axis at the middle        |rel| <= 10 %
                        (clasp: the apex's, reported only: the FEM's is the
-                       section centroids', not the nominal axis's)
+                       section centroids', not the nominal axis's; the
+                       crossing's straight rods: none)
 pressure               peak contact pressure over E                        reported only
 =====================  ==================================================  ==============
 
@@ -47,7 +53,7 @@ from typing import Any
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .scenes._common import MESH_LEVELS, relative
 
-ROW_SCENES: tuple[str, ...] = ("soft_wrap", "clasp")
+ROW_SCENES: tuple[str, ...] = ("soft_wrap", "clasp", "soft_crossing")
 """The cross-check's scenes with two soft rods."""
 
 CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed")
@@ -73,7 +79,8 @@ def fem_runs(mesh: str, fem_results: dict[str, dict] | None = None) -> dict[str,
         for level, key in ((mesh, name), (spread, f"{name}@{spread}")):
             if level is None or key in out:
                 continue
-            extra = {"compare": False} if name == "soft_wrap" else {}
+            # (the scenes' own comparison with a rigid counter-body is not needed here)
+            extra = {"compare": False} if name in ("soft_wrap", "soft_crossing") else {}
             out[key] = run_scene(name, mesh=level, convergence=False, **extra)
     return out
 
@@ -98,10 +105,11 @@ def _rod_runs(fem: dict[str, dict], contact: Any) -> dict[str, dict]:
     """The rod model at the FEM's load levels and parameters, at level ``contact``; with
     the FEM's relaxed U's at hand also the clasp with the kinematics matched (key
     "clasp_matched", its ``kinematic_offset``, :func:`clasp_kinematic_offset`)."""
-    from .rod_model_soft import rod_clasp, rod_soft_wrap
+    from .rod_model_soft import rod_clasp, rod_soft_crossing, rod_soft_wrap
 
     wp = fem["soft_wrap"]["parameters"]
     cp = fem["clasp"]["parameters"]
+    xp = fem["soft_crossing"]["parameters"]
     d0 = cp["diameter_m"]
 
     def clasp(gap: float) -> dict[str, Any]:
@@ -119,6 +127,10 @@ def _rod_runs(fem: dict[str, dict], contact: Any) -> dict[str, dict]:
                                    length_over_d0=wp["segment_length_m"] / wp["diameter_m"],
                                    contact=contact),
         "clasp": clasp(cp["initial_gap_m"]),
+        "soft_crossing": rod_soft_crossing(
+            [s["w_over_d0"] * xp["diameter_m"] for s in fem["soft_crossing"]["steps"]],
+            diameter=xp["diameter_m"], youngs_modulus=xp["youngs_modulus_pa"],
+            length_over_d0=xp["segment_length_m"] / xp["diameter_m"], contact=contact),
     }
     relaxed = fem["clasp"].get("relaxed")
     if relaxed is not None and runs["clasp"]["relaxed"]:
@@ -130,12 +142,14 @@ def _rod_runs(fem: dict[str, dict], contact: Any) -> dict[str, dict]:
 
 
 #: Per scene: (FEM force key, rod force key, FEM area key, rod area key, FEM curvature key,
-#: rod curvature key, whether the curvature has a target).
-_KEYS: dict[str, tuple[str, str, str, str, str, str, bool]] = {
+#: rod curvature key (None: no curvature), whether the curvature has a target).
+_KEYS: dict[str, tuple[str, str, str, str, str | None, str | None, bool]] = {
     "soft_wrap": ("force_per_length_mid_nominal", "force_per_length_mid", "area_ratio_mid",
                   "area_ratio_mid", "kappa_d0_mid_nominal", "kappa_d0_mid", True),
     "clasp": ("force", "force", "area_ratio_apex", "area_ratio_apex", "kappa_d0_apex",
               "kappa_d0_apex", False),
+    "soft_crossing": ("force", "force", "area_ratio_mid", "area_ratio_mid", None, None,
+                      False),
 }
 
 
@@ -160,8 +174,9 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
             "force_rel": relative(r[r_key], f[f_key]),
             "fem_area_ratio": f[fa_key], "rod_area_ratio": r[ra_key],
             "area_points": r[ra_key] - f[fa_key],
-            "fem_kappa_d0": f[fk_key], "rod_kappa_d0": r[rk_key],
-            "curvature_rel": relative(r[rk_key], f[fk_key]),
+            "fem_kappa_d0": f[fk_key] if fk_key else None,
+            "rod_kappa_d0": r[rk_key] if rk_key else None,
+            "curvature_rel": relative(r[rk_key], f[fk_key]) if fk_key else None,
             "fem_peak_pressure_over_e": f["peak_pressure_over_e"],
             "rod_peak_pressure_over_e": r["peak_pressure_over_e"],
             "pressure_rel": relative(r["peak_pressure_over_e"], f["peak_pressure_over_e"]),
@@ -169,7 +184,7 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
             "fem_spread_rel": None if c is None else {
                 "force": relative(f[f_key], c[f_key]),
                 "area_points": f[fa_key] - c[fa_key],
-                "curvature": relative(f[fk_key], c[fk_key])},
+                "curvature": relative(f[fk_key], c[fk_key]) if fk_key else None},
         }
         if m is not None:
             row["rod_force_kinematics_matched"] = m[r_key]
@@ -180,7 +195,7 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
         if kappa_target:
             row["met"]["curvature"] = abs(row["curvature_rel"]) <= TARGETS["curvature_rel"]
         rows.append(row)
-    worst = {k: max((abs(x[k]) for x in rows), default=None)
+    worst = {k: max((abs(x[k]) for x in rows if x[k] is not None), default=None)
              for k in ("force_rel", "area_points", "curvature_rel", "pressure_rel")}
     spreads = [x["fem_spread_rel"]["force"] for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
@@ -229,9 +244,9 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
                           for s in scenes.values()),
         }
     return {
-        "what": "two soft rods: the soft wrap's mid line load and the clasp's pull force, "
-                "FEM against the rod model at each contact level, with the FEM's mesh "
-                "spread (tightknot/fem/crosscheck_soft.py)",
+        "what": "two soft rods: the soft wrap's mid line load, the clasp's pull force and "
+                "the soft crossing's force, FEM against the rod model at each contact "
+                "level, with the FEM's mesh spread (tightknot/fem/crosscheck_soft.py)",
         "mesh": mesh,
         "spread_mesh": spread,
         "fem": {name: {"mesh": fem[name]["mesh"], "wall_time_s": fem[name]["wall_time_s"],

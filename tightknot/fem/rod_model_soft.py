@@ -1,7 +1,9 @@
-"""The rod model in the FEM's two-soft-rod scenes: the soft wrap and the clasp.
+"""The rod model in the FEM's two-soft-rod scenes: the soft wrap, the clasp and the soft
+crossing.
 
-The same load levels and parameters as :mod:`tightknot.fem.scenes.soft_wrap` and
-:mod:`tightknot.fem.scenes.clasp`, on the rod model (DER rods, straight at rest) with its
+The same load levels and parameters as :mod:`tightknot.fem.scenes.soft_wrap`,
+:mod:`tightknot.fem.scenes.clasp` and :mod:`tightknot.fem.scenes.soft_crossing`, on the
+rod model (DER rods, straight at rest) with its
 contact term at a chosen level. Both partners are soft here, so the pair law is the
 shipped one, the overlap split evenly between the two rods (no rigid counter-body
 scaling, unlike :mod:`tightknot.fem.rod_model`).
@@ -34,6 +36,13 @@ from .rod_model import (
 
 CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed", "sectioned")
 """Contact levels of the rod model here (:func:`contact_term`)."""
+
+#: Rods on each side of rod A in the soft crossing's stack (:func:`soft_crossing_scene`):
+#: the outermost ones, pressed from one side only, perturb the inner contacts through the
+#: chain of sections between them, by turns up and down with the depth. At 6 the sectioned
+#: level's force at the FEM's levels within the approach limit moves by at most 0.7 % from
+#: 5 (at the deepest, w = 0.15 D0, by 4.5 %; docs/sectioned_level.md).
+STACK_DEPTH: int = 6
 
 
 def check_contact(contact: Any) -> Any:
@@ -276,4 +285,106 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
     return {"steps": rows, "relaxed": relaxed, "relaxed_apex_shift_over_d0": apex_shift / d0,
             "relaxed_area_ratio_apex": relaxed_area, "relaxed_inner_side_over_r": inner,
             "wall_time_s": time.perf_counter() - start,
+            "vertices": int(model.vertex_count), "contact": _name(contact)}
+
+
+def soft_crossing_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
+                        edges_per_d0: int = EDGES_PER_D0, depth: int = STACK_DEPTH
+                        ) -> tuple[Any, Any, list[int], tuple[int, ...]]:
+    """The FEM's ``soft_crossing`` stack (:mod:`tightknot.fem.scenes.soft_crossing`) as
+    rods: every rod pressed from both sides by rods like it crossing at 90 degrees, each
+    held on its mid-plane. 2 ``depth`` + 1 rods, alternately along e_z and e_x, at y = k s
+    for k = 0, 1, -1, ..., depth, -depth (s = D0 - 2 w at the level load w, touching at
+    rest): rod A (k = 0) and rod B (k = 1) are pressed from both sides, the outermost two
+    close the stack (pressed from one side only). Each rod's centreline is held at its y
+    (the FEM's held mid-plane) and in the symmetry plane that holds its axis (x = 0 for
+    those along e_z, z = 0 for those along e_x), its middle vertex in the other symmetry
+    plane; it slides and stretches along its axis. Returns the system, the level load, the
+    rods' edge counts and their k."""
+    from tightknot.loading.levels import LevelLoad
+    from tightknot.rods.boundary import BoundaryConditions
+    from tightknot.rods.builder import RodBuilder
+    from tightknot.rods.material import Material
+    from tightknot.rods.state import State
+    from tightknot.solvers.system import RodSystem
+
+    from .rod_model import _line_points, check_edges_per_d0
+
+    check_edges_per_d0(edges_per_d0)
+    if isinstance(depth, bool) or not isinstance(depth, int) or depth < 1:
+        raise ValueError(f"depth must be an integer >= 1, got {depth!r}")
+    d0 = diameter
+    n = int(round(length_over_d0 * edges_per_d0))
+    n += n % 2  # even: a vertex at the crossing
+    half = 0.5 * length_over_d0 * d0
+    mat = Material(youngs_modulus, 0.5, DENSITY)
+    load = LevelLoad()
+    b = RodBuilder(twist=False)
+    levels = (0, *(k * sign for k in range(1, depth + 1) for sign in (1, -1)))
+    for k in levels:
+        axis = np.array([0.0, 0.0, 1.0]) if k % 2 == 0 else np.array([1.0, 0.0, 0.0])
+        centre = np.array([0.0, k * d0, 0.0])
+        b.add_rod(_line_points(centre - half * axis, centre + half * axis, n), d0, mat)
+    model = b.finalize()
+    bcs = BoundaryConditions(model)
+    for rod, k in enumerate(levels):
+        plane = 0 if k % 2 == 0 else 2  # the symmetry plane that holds the rod's axis
+        for v in range(n + 1):
+            bcs.hold_components(rod, v, (1,), lambda t, k=k: np.array(
+                [k * (d0 - 2.0 * load(t))]))
+            bcs.fix_components(rod, v, (plane,))
+        bcs.fix_components(rod, n // 2, (2 - plane,))
+    system = RodSystem(model, State.initial(model), bcs)
+    return system, load, [n] * len(levels), levels
+
+
+def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
+                      youngs_modulus: float = YOUNGS_MODULUS, length_over_d0: float = 3.0,
+                      law: Any = None, contact: Any = "compliant",
+                      edges_per_d0: int = EDGES_PER_D0, depth: int = STACK_DEPTH
+                      ) -> dict[str, Any]:
+    """The soft crossing with the rod model: the stack of :func:`soft_crossing_scene`,
+    its neighbours moved toward each other by 2 w [m] (``w_levels``: the approach per rod,
+    as in the FEM scene), at contact level ``contact``.
+
+    Returns per level: ``force`` [N] between rods A and B (the contact force on the rods
+    above A, which inside them only A pushes), ``force_from_below`` (the same for the
+    rods below, the stack's symmetry), ``approach_over_d0`` (2 w / D0),
+    ``area_ratio_mid`` and ``area_ratio_mid_b`` (A's and B's crossing sections),
+    ``peak_pressure_over_e`` and ``contact_width_fraction_mid`` (A's crossing section, its
+    two contacts); and the wall time."""
+    start = time.perf_counter()
+    check_contact(contact)
+    d0 = diameter
+    system, load, edges, levels = soft_crossing_scene(diameter, youngs_modulus,
+                                                      length_over_d0, edges_per_d0, depth)
+    model = system.model
+    term = contact_term(model, contact, law)
+    system.add_term(term)
+    mid = edges[0] // 2
+    a_v = model.rods[0].vertex_start + mid
+    b_v = model.rods[1].vertex_start + mid
+    def rods(side: int) -> np.ndarray:
+        return np.concatenate([np.arange(model.rods[r].vertex_start,
+                                         model.rods[r].vertex_start + edges[r] + 1)
+                               for r, k in enumerate(levels) if k * side > 0])
+
+    above, below = rods(1), rods(-1)
+
+    def measure(w: float) -> dict[str, Any]:
+        g = system.term_gradient(term)
+        force = -float(g[above, 1].sum())
+        rep = _report(term, system)
+        return {
+            "w_over_d0": w / d0, "approach_over_d0": 2.0 * w / d0, "force": force,
+            "force_from_below": float(g[below, 1].sum()),
+            "force_over_e_d0sq": force / (youngs_modulus * d0**2),
+            "area_ratio_mid": float(rep.area_ratio[a_v]),
+            "area_ratio_mid_b": float(rep.area_ratio[b_v]),
+            "peak_pressure_over_e": float(rep.peak_pressure_over_E[a_v]),
+            "contact_width_fraction_mid": float(rep.contact_width_fraction[a_v]),
+        }
+
+    rows = _solve_levels(system, load, list(w_levels), measure)
+    return {"steps": rows, "wall_time_s": time.perf_counter() - start,
             "vertices": int(model.vertex_count), "contact": _name(contact)}

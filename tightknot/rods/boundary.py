@@ -17,6 +17,8 @@ from tightknot.rods import frames
 from tightknot.rods.model import Model
 
 PathVec = Callable[[float], np.ndarray]
+#: A held vertex's component values [m]: fixed, or a function of the load parameter t.
+HeldValues = np.ndarray | Callable[[float], np.ndarray]
 
 
 def _as_path_vec(value: np.ndarray | PathVec | None, name: str) -> PathVec | None:
@@ -76,7 +78,7 @@ class BoundaryConditions:
         self._pins: list[_Pin] = []
         self._fixed_twist: list[int] = []
         self._components: list[tuple[int, tuple[int, ...]]] = []
-        self._held: list[tuple[int, tuple[int, ...], np.ndarray]] = []
+        self._held: list[tuple[int, tuple[int, ...], HeldValues]] = []
         self._forces: list[tuple[int, PathVec]] = []
         self._rest_scale: list[tuple[np.ndarray, Callable[[float], float]]] = []
 
@@ -147,16 +149,20 @@ class BoundaryConditions:
 
     def hold_components(
         self, rod: int = 0, vertex: int = 0, components: tuple[int, ...] = (1, 2),
-        values: tuple[float, ...] | np.ndarray = (0.0, 0.0),
+        values: tuple[float, ...] | HeldValues = (0.0, 0.0),
     ) -> BoundaryConditions:
-        """Fix some coordinates of a vertex at given ``values`` [m], written into the state
-        at every load step: a vertex held on an axis, as a grip holds a rod's tail."""
+        """Fix some coordinates of a vertex at given ``values`` [m] (or at ``values(t)``
+        along the load path), written into the state at every load step: a vertex held on
+        an axis, as a grip holds a rod's tail, or on a plane that moves."""
         self.fix_components(rod, vertex, components)
-        vals = np.asarray(values, dtype=np.float64).reshape(-1)
-        if vals.size != len(self._components[-1][1]) or not np.isfinite(vals).all():
-            raise ValueError(f"values must be {len(self._components[-1][1])} finite numbers "
-                             f"(one per component), got {values!r}")
         v, comps = self._components[-1]
+        if callable(values):
+            self._held.append((v, comps, values))
+            return self
+        vals = np.asarray(values, dtype=np.float64).reshape(-1)
+        if vals.size != len(comps) or not np.isfinite(vals).all():
+            raise ValueError(f"values must be {len(comps)} finite numbers "
+                             f"(one per component), got {values!r}")
         self._held.append((v, comps, vals))
         return self
 
@@ -243,6 +249,11 @@ class BoundaryConditions:
         for p in self._pins:
             x[p.vertex] = p.x0 + (p.translation(t) if p.translation else 0.0)
         for v, comps, vals in self._held:
+            if callable(vals):
+                vals = np.asarray(vals(t), dtype=np.float64).reshape(-1)
+                if vals.size != len(comps) or not np.isfinite(vals).all():
+                    raise ValueError(f"held components {comps} of vertex {v} at t = {t}: "
+                                     f"{len(comps)} finite values needed, got {vals!r}")
             x[v, list(comps)] = vals
 
     def prescribe_twist(
