@@ -255,3 +255,31 @@ def test_random_input_builds_or_raises_value_error(
     assert np.isfinite(model.vertex_initial_position).all()
     assert model.edge_count == (n if closed else n - 1)
     assert (model.edge_rest_length > 0).all()
+
+
+def test_held_components_follow_the_load_and_refuse_bad_values() -> None:
+    """A vertex held on a moving plane: its held coordinate is written at each load
+    parameter; a function giving the wrong number of values, or a non-finite one, is
+    refused with the vertex and components named."""
+    from tightknot.rods.boundary import BoundaryConditions
+
+    b = RodBuilder(twist=False)
+    b.add_rod(line(4), 0.001)
+    model = b.finalize()
+    bcs = BoundaryConditions(model)
+    bcs.hold_components(0, 1, (1,), lambda t: np.array([0.002 * t]))
+    bcs.hold_components(0, 2, (0, 2), (0.5, 0.25))
+    x = line(4)
+    bcs.prescribe_positions(0.5, x)
+    assert x[1, 1] == 0.001 and list(x[2, [0, 2]]) == [0.5, 0.25]
+    assert bcs.fixed_mask()[model.vertex_dof[1] + 1]
+    bad = BoundaryConditions(model)
+    bad.hold_components(0, 1, (1, 2), lambda t: np.array([t]))
+    with pytest.raises(ValueError, match=r"held components \(1, 2\) of vertex 1"):
+        bad.prescribe_positions(0.5, line(4))
+    worse = BoundaryConditions(model)
+    worse.hold_components(0, 1, (1,), lambda t: np.array([math.nan]))
+    with pytest.raises(ValueError, match="finite"):
+        worse.prescribe_positions(0.5, line(4))
+    with pytest.raises(ValueError, match="values must be 2 finite numbers"):
+        BoundaryConditions(model).hold_components(0, 1, (1, 2), (0.0,))
