@@ -246,3 +246,30 @@ def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
     text = format_table(table)
     assert "| sectioned + bend shift |" in text and "-20.0 .. +10.0 %" in text
     assert "soft wrap and the clasp at compliant, smoothed, sectioned" in table["not_covered"]
+
+
+def test_each_compared_level_has_the_fem_spread_beside_it() -> None:
+    """Given the coarser mesh's run at the same levels, every compared row reports the
+    FEM's own force and area differences (ground rule 4), and the comparison its largest;
+    without one, None (the coarse mesh has no coarser)."""
+    from tightknot.fem.crosscheck import _compare
+
+    def step(force, approach, area):
+        return {"approach_over_d0": approach, "force": force, "area_ratio_mid": area,
+                "peak_pressure_over_e": 0.1}
+
+    fem = [step(1.0, 0.1, 0.99), step(2.0, 0.2, 0.97), step(3.0, 0.3, 0.95)]
+    coarse = [step(1.1, 0.1, 0.98), step(1.9, 0.2, 0.975), step(3.0, 0.3, 0.9)]
+    rod = [dict(step(1.05, 0.1, 0.985), converged=True),
+           dict(step(2.0, 0.2, 0.97), converged=True),
+           dict(step(3.0, 0.3, 0.95), converged=True)]
+    out = _compare(fem, rod, ("force", "force"), None, spread_steps=coarse)
+    assert len(out["levels"]) == 2  # the third lies past the approach limit
+    first, second = out["levels"]
+    assert first["fem_spread_rel"]["force"] == pytest.approx(1.0 / 1.1 - 1.0)
+    assert first["fem_spread_rel"]["area_points"] == pytest.approx(0.01)
+    assert second["fem_spread_rel"]["force"] == pytest.approx(2.0 / 1.9 - 1.0)
+    assert out["fem_force_spread_max"] == pytest.approx(abs(1.0 / 1.1 - 1.0))
+    plain = _compare(fem, rod, ("force", "force"), None)
+    assert all(r["fem_spread_rel"] is None for r in plain["levels"])
+    assert plain["fem_force_spread_max"] is None

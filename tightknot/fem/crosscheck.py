@@ -59,6 +59,12 @@ footprint in both models (``indent_footprint``); the wrap with variants of the p
 (``wrap_kernel_variants``, :mod:`tightknot.fem.wrap_variants`): where the wrap's line-load
 deficit does not come from.
 
+The FEM's own spread (``fem_spread_rel`` of each compared level, ``fem_force_spread_max``
+of each comparison): the same scene on the next coarser mesh (:func:`tightknot.fem.
+crosscheck_soft.spread_mesh`; none on the coarse mesh) at the same levels, its force's
+relative difference and its A/A0's in points: a rod-model error below it is within what
+the FEM itself can tell. Reported beside the targets, not part of ``passed``.
+
 Wall time. ``fem_over_rod_time_ratio`` is the FEM wall time of the compared runs (one mesh
 each, all load levels) over the rod model's (all levels, model set-up included, after
 one untimed warm-up that compiles the Warp kernels; the warm-up time is reported too).
@@ -70,6 +76,7 @@ import math
 import time
 from typing import Any
 
+from .crosscheck_soft import spread_mesh
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .material import ROD_DIAMETER
 from .rod_model import EDGES_PER_D0, check_edges_per_d0, rod_indent, rod_wrap
@@ -99,17 +106,23 @@ def fem_width_fraction(step: dict[str, Any], scene: str) -> float | None:
 
 def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str, str],
              kappa_key: str | None, width_scene: str | None = None,
-             limit: float = APPROACH_LIMIT) -> dict[str, Any]:
+             limit: float = APPROACH_LIMIT, spread_steps: list[dict] | None = None
+             ) -> dict[str, Any]:
     """Per-level comparison up to an approach of ``limit`` D0 (gated on the FEM's
     ``approach_over_d0``; default ``APPROACH_LIMIT``, the targets' range).
     ``force_keys``: (FEM key, rod key) of the compared force; ``kappa_key``: the FEM
     key of the axis curvature compared with the rod's ``kappa_d0_mid`` (None: not
     compared); ``width_scene``: compare the mid section's
     contact width fraction (the rod's ``contact_width_fraction_mid``) with the FEM's
-    (:func:`fem_width_fraction` of that scene), None: not compared."""
+    (:func:`fem_width_fraction` of that scene), None: not compared; ``spread_steps``: the
+    same scene on the next coarser mesh at the same levels, whose difference from
+    ``fem_steps`` each row reports as the FEM's own spread (``fem_spread_rel``: force
+    relative, area in points; None without)."""
     fem_force, rod_force = force_keys
     rows = []
-    for f, r in zip(fem_steps, rod_steps, strict=True):
+    spread = list(spread_steps or [])
+    spread += [None] * (len(fem_steps) - len(spread))
+    for f, r, c in zip(fem_steps, rod_steps, spread, strict=True):
         if f["approach_over_d0"] > limit + 1e-9:
             continue
         row = {
@@ -123,6 +136,9 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
             "rod_peak_pressure_over_e": r["peak_pressure_over_e"],
             "pressure_rel": relative(r["peak_pressure_over_e"], f["peak_pressure_over_e"]),
             "rod_converged": r["converged"],
+            "fem_spread_rel": None if c is None else {
+                "force": relative(f[fem_force], c[fem_force]),
+                "area_points": f["area_ratio_mid"] - c["area_ratio_mid"]},
         }
         if kappa_key is not None:
             row.update(fem_kappa_d0=f[kappa_key], rod_kappa_d0=r["kappa_d0_mid"],
@@ -146,7 +162,9 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
              for k in ("force_rel", "area_points", "pressure_rel")
              + (("curvature_rel",) if kappa_key is not None else ())
              + (("width_fraction",) if width_scene is not None else ())}
+    spreads = [abs(x["fem_spread_rel"]["force"]) for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
+            "fem_force_spread_max": max(spreads, default=None),
             "passed": bool(rows) and all(all(x["met"].values()) for x in rows)}
 
 
@@ -297,7 +315,8 @@ def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
 
 
 def _smoothed_level(fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
-                    rod_ind: dict[str, Any], rod_wr: dict[str, Any]) -> dict[str, Any]:
+                    rod_ind: dict[str, Any], rod_wr: dict[str, Any],
+                    spread: dict[str, list[dict] | None]) -> dict[str, Any]:
     """Both scenes with the "smoothed" contact level (the section thinned by the stretch
     averaged over +-1 D0 along the rod, :mod:`tightknot.contact.section_radius`): the same
     comparisons and targets as the default level's, reported beside them (``passed`` of
@@ -307,10 +326,11 @@ def _smoothed_level(fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
     ind = _rod_indent_like(fem_ind, radius_window=window)
     wr = _rod_wrap_like(fem_wrap, radius_window=window)
     comp = {
-        "indent": _compare(fem_ind["steps"], ind["steps"], ("force", "force"), None),
+        "indent": _compare(fem_ind["steps"], ind["steps"], ("force", "force"), None,
+                           spread_steps=spread["indent"]),
         "wrap": _compare(fem_wrap["steps"], wr["steps"],
                          ("force_per_length_mid_nominal", "force_per_length_mid"),
-                         "kappa_d0_mid_nominal"),
+                         "kappa_d0_mid_nominal", spread_steps=spread["wrap"]),
     }
     axial = [{"approach_over_d0": f["approach_over_d0"],
               "fem_axial_force_mid_over_e_d0sq": f.get("axial_force_mid_over_e_d0sq"),
@@ -387,9 +407,20 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     if "wrap" not in fem_results:
         fem_results["wrap"] = run_scene("wrap", mesh=mesh, convergence=False)
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
+    # the FEM's own spread beside each compared level: the next coarser mesh's run
+    coarser = spread_mesh(mesh)
+    spread: dict[str, list[dict] | None] = {"indent": None, "wrap": None}
+    if coarser is not None:
+        for name in ("indent", "wrap"):
+            key = f"{name}@{coarser}"
+            if key not in fem_results:
+                fem_results[key] = run_scene(name, mesh=coarser, convergence=False)
+            spread[name] = fem_results[key]["steps"]
     if contact == "sectioned":
         report = _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift,
-                                   thinning, rod_edges_per_d0)
+                                   thinning, rod_edges_per_d0, spread)
+        report["fem_results"].update({k: v for k, v in fem_results.items()
+                                      if k.startswith(("indent@", "wrap@"))})
         if soft:
             from tightknot.contact.sectioned import SectionSettings
 
@@ -412,7 +443,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     diagnostics = _indent_diagnostics(fem_ind, rod_ind)
     diagnostics["indent_footprint"] = _indent_footprint(fem_ind, rod_ind)
     diagnostics["wrap_kernel_variants"] = _wrap_variants(fem_wrap)
-    smoothed = _smoothed_level(fem_ind, fem_wrap, rod_ind, rod_wr)
+    smoothed = _smoothed_level(fem_ind, fem_wrap, rod_ind, rod_wr, spread)
     fem_time = fem_ind["wall_time_s"] + fem_wrap["wall_time_s"]
     rod_time = rod_ind["wall_time_s"] + rod_wr["wall_time_s"]
     scenes = {
@@ -422,7 +453,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
             "fem_mesh": fem_ind["mesh"], "fem_wall_time_s": fem_ind["wall_time_s"],
             "rod_wall_time_s": rod_ind["wall_time_s"], "rod_vertices": rod_ind["vertices"],
             "comparison": _compare(fem_ind["steps"], rod_ind["steps"], ("force", "force"),
-                                   None),
+                                   None, spread_steps=spread["indent"]),
             "fem_steps": fem_ind["steps"], "rod_steps": rod_ind["steps"],
         },
         "wrap": {
@@ -432,7 +463,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
             "wrap_angle_deg": wp_["wrap_angle_deg"],
             "comparison": _compare(fem_wrap["steps"], rod_wr["steps"],
                                    ("force_per_length_mid_nominal", "force_per_length_mid"),
-                                   "kappa_d0_mid_nominal"),
+                                   "kappa_d0_mid_nominal", spread_steps=spread["wrap"]),
             "centroid_axis": _wrap_centroid_axis(fem_wrap["steps"], rod_wr["steps"]),
             "total_force_statics": [
                 {"tension_over_e_d0sq": f["tension_over_e_d0sq"],
@@ -461,7 +492,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         "passed": (all(s["comparison"]["passed"] for s in scenes.values())
                    and fem_time / rod_time >= 1000.0),
         "contact": "compliant",
-        "fem_results": {"indent": fem_ind, "wrap": fem_wrap},
+        "fem_results": {k: v for k, v in fem_results.items()
+                        if k in ("indent", "wrap") or k.startswith(("indent@", "wrap@"))},
     }
     if soft:
         from .crosscheck_soft import fem_runs, soft_rows
@@ -477,7 +509,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
 
 def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
                       section_modes: int, start: float, bend_shift: bool = False,
-                      thinning: str = "edge", edges_per_d0: int = EDGES_PER_D0
+                      thinning: str = "edge", edges_per_d0: int = EDGES_PER_D0,
+                      spread: dict[str, list[dict] | None] | None = None
                       ) -> dict[str, Any]:
     """The cross-check of the sectioned level (:mod:`tightknot.fem.rod_sectioned`): force,
     A/A0, L_c and (wrap) curvature at every level, against the targets."""
@@ -501,7 +534,8 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
             "fem_mesh": fem_ind["mesh"], "fem_wall_time_s": fem_ind["wall_time_s"],
             "rod_wall_time_s": rod_ind["wall_time_s"], "rod_vertices": rod_ind["vertices"],
             "comparison": _compare(fem_ind["steps"], rod_ind["steps"], ("force", "force"),
-                                   None, width_scene="indent"),
+                                   None, width_scene="indent",
+                                   spread_steps=(spread or {}).get("indent")),
             "fem_steps": fem_ind["steps"], "rod_steps": rod_ind["steps"],
         },
         "wrap": {
@@ -510,7 +544,8 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
             "rod_wall_time_s": rod_wr["wall_time_s"], "rod_vertices": rod_wr["vertices"],
             "comparison": _compare(fem_wrap["steps"], rod_wr["steps"],
                                    ("force_per_length_mid_nominal", "force_per_length_mid"),
-                                   "kappa_d0_mid_nominal", width_scene="wrap"),
+                                   "kappa_d0_mid_nominal", width_scene="wrap",
+                                   spread_steps=(spread or {}).get("wrap")),
             "centroid_axis": [
                 {"tension_over_e_d0sq": f["tension_over_e_d0sq"],
                  "fem_kappa_d0_centroid": f["kappa_d0_mid"],
