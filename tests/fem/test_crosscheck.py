@@ -270,6 +270,11 @@ def test_each_compared_level_has_the_fem_spread_beside_it() -> None:
     assert first["fem_spread_rel"]["area_points"] == pytest.approx(0.01)
     assert second["fem_spread_rel"]["force"] == pytest.approx(2.0 / 1.9 - 1.0)
     assert out["fem_force_spread_max"] == pytest.approx(abs(1.0 / 1.1 - 1.0))
+    # a coarser run at other load levels gives no spread
+    moved = [dict(c, w_over_d0=0.5) for c in coarse]
+    fem_w = [dict(f, w_over_d0=0.25) for f in fem]
+    assert all(r["fem_spread_rel"] is None for r in
+               _compare(fem_w, rod, ("force", "force"), None, spread_steps=moved)["levels"])
     plain = _compare(fem, rod, ("force", "force"), None)
     assert all(r["fem_spread_rel"] is None for r in plain["levels"])
     assert plain["fem_force_spread_max"] is None

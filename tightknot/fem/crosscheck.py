@@ -125,6 +125,9 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
     for f, r, c in zip(fem_steps, rod_steps, spread, strict=True):
         if f["approach_over_d0"] > limit + 1e-9:
             continue
+        if c is not None and any(k in f and k in c and not math.isclose(f[k], c[k])
+                                 for k in ("w_over_d0", "tension")):
+            c = None  # another load level: no spread to report
         row = {
             "approach_over_d0": f["approach_over_d0"],
             "rod_approach_over_d0": r["approach_over_d0"],
