@@ -226,3 +226,15 @@ def test_the_last_slope_of_a_search() -> None:
     assert _last_slope(pts[:1]) is None  # one equilibrium
     assert _last_slope([pts[0], pts[0]]) is None  # one force
     assert _last_slope([pts[0], (math.log(1.85), 15.5)]) is None  # rising: no secant
+
+
+def test_a_failed_final_route_on_an_open_knot_names_the_pull_path() -> None:
+    """Where the sections fail to join a pulled open knot at its end (the final route: a
+    20 N pull, docs/sectioned_level.md), the failure says which path adds them before the
+    pull; a closed knot or the pull route has no such hint."""
+    from tightknot.knots.scenes import closed_trefoil, open_trefoil
+    from tightknot.loading.tie import _route_hint
+
+    opened, closed = open_trefoil(0.185, nodes=90), closed_trefoil(nodes=40)
+    assert "--section-path pull" in _route_hint(opened, "final")
+    assert _route_hint(opened, "pull") == _route_hint(closed, "final") == ""

@@ -349,6 +349,16 @@ def _direct_solve(system: RodSystem, layer: ContactLayer | None, options: Newton
     return r, iters + more
 
 
+def _route_hint(scene: KnotScene, route: str) -> str:
+    """What to try where the sections failed to join a pulled open knot at its end (the
+    ``final`` route): the ``pull`` path adds them before the pull, which then moves the
+    sections with the knot (docs/sectioned_level.md, "Cost, and what is left")."""
+    if route != "final" or scene.closed:
+        return ""
+    return (" (the sections joined the knot at the end of its pull; --section-path pull "
+            "adds them before the pull)")
+
+
 def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
                    hook: StepHook | None = None,
                    knot_type: Callable[[KnotScene, np.ndarray], str] = knot_type_of,
@@ -407,7 +417,8 @@ def section_finish(scene: KnotScene, res: TieResult, residual_tol: float,
         tried.append(f"proximal steps from the start: {reason}")
     why = ""
     if not r.converged:
-        why = "; ".join(tried) + (f": {system.violation}" if system.violation else "")
+        why = ("; ".join(tried) + (f": {system.violation}" if system.violation else "")
+               + _route_hint(scene, res.section_path))
     types = list(res.knot_types)
     rec = StepRecord(done.t, r)
     if not why:
