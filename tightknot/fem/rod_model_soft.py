@@ -3,8 +3,8 @@ crossing.
 
 The same load levels and parameters as :mod:`tightknot.fem.scenes.soft_wrap`,
 :mod:`tightknot.fem.scenes.clasp` and :mod:`tightknot.fem.scenes.soft_crossing`, on the
-rod model (DER rods, straight at rest) with its
-contact term at a chosen level. Both partners are soft here, so the pair law is the
+rod model (DER rods, straight at rest) with its contact term at a chosen level. Both
+partners are soft here, so the pair law is the
 shipped one, the overlap split evenly between the two rods (no rigid counter-body
 scaling, unlike :mod:`tightknot.fem.rod_model`).
 
@@ -364,6 +364,7 @@ def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
     mid = edges[0] // 2
     a_v = model.rods[0].vertex_start + mid
     b_v = model.rods[1].vertex_start + mid
+
     def rods(side: int) -> np.ndarray:
         return np.concatenate([np.arange(model.rods[r].vertex_start,
                                          model.rods[r].vertex_start + edges[r] + 1)
