@@ -76,7 +76,7 @@ import math
 import time
 from typing import Any
 
-from .crosscheck_soft import spread_mesh
+from .crosscheck_soft import fem_spread, spread_mesh
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .material import ROD_DIAMETER
 from .rod_model import EDGES_PER_D0, check_edges_per_d0, rod_indent, rod_wrap
@@ -116,8 +116,8 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
     contact width fraction (the rod's ``contact_width_fraction_mid``) with the FEM's
     (:func:`fem_width_fraction` of that scene), None: not compared; ``spread_steps``: the
     same scene on the next coarser mesh at the same levels, whose difference from
-    ``fem_steps`` each row reports as the FEM's own spread (``fem_spread_rel``: force
-    relative, area in points; None without)."""
+    ``fem_steps`` each row reports as the FEM's own spread (``fem_spread_rel``:
+    :func:`~tightknot.fem.crosscheck_soft.fem_spread`; None without)."""
     fem_force, rod_force = force_keys
     rows = []
     spread = list(spread_steps or [])
@@ -139,9 +139,7 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
             "rod_peak_pressure_over_e": r["peak_pressure_over_e"],
             "pressure_rel": relative(r["peak_pressure_over_e"], f["peak_pressure_over_e"]),
             "rod_converged": r["converged"],
-            "fem_spread_rel": None if c is None else {
-                "force": relative(f[fem_force], c[fem_force]),
-                "area_points": f["area_ratio_mid"] - c["area_ratio_mid"]},
+            "fem_spread_rel": fem_spread(f, c, fem_force, "area_ratio_mid", kappa_key),
         }
         if kappa_key is not None:
             row.update(fem_kappa_d0=f[kappa_key], rod_kappa_d0=r["kappa_d0_mid"],

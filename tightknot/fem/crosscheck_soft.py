@@ -60,6 +60,19 @@ CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed")
 """The rod model's contact levels compared (:mod:`tightknot.fem.rod_model_soft`)."""
 
 
+def fem_spread(fem: dict[str, Any], coarser: dict[str, Any] | None, force_key: str,
+               area_key: str, kappa_key: str | None = None) -> dict[str, Any] | None:
+    """The FEM's own spread at one level: its force relative to the coarser mesh's at the
+    same level, its area's difference in points and (``kappa_key``) its curvature's
+    relative one; None without the coarser run."""
+    if coarser is None:
+        return None
+    return {"force": relative(fem[force_key], coarser[force_key]),
+            "area_points": fem[area_key] - coarser[area_key],
+            "curvature": (relative(fem[kappa_key], coarser[kappa_key]) if kappa_key
+                          else None)}
+
+
 def spread_mesh(mesh: str) -> str | None:
     """The mesh whose difference from ``mesh`` is the FEM's spread: the next coarser one
     (None for the coarsest)."""
@@ -181,10 +194,7 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
             "rod_peak_pressure_over_e": r["peak_pressure_over_e"],
             "pressure_rel": relative(r["peak_pressure_over_e"], f["peak_pressure_over_e"]),
             "rod_converged": bool(r["converged"]),
-            "fem_spread_rel": None if c is None else {
-                "force": relative(f[f_key], c[f_key]),
-                "area_points": f[fa_key] - c[fa_key],
-                "curvature": relative(f[fk_key], c[fk_key]) if fk_key else None},
+            "fem_spread_rel": fem_spread(f, c, f_key, fa_key, fk_key),
         }
         if m is not None:
             row["rod_force_kinematics_matched"] = m[r_key]
