@@ -129,3 +129,25 @@ def test_plot_of_a_store_without_levels_is_bad_input(tmp_path: Path, capsys) -> 
     assert main(["plot", str(tmp_path / "c")]) == 2
     assert "no open-knot levels" in capsys.readouterr().err
     json.loads((tmp_path / "c" / "index.json").read_text())  # the store is untouched
+
+
+def test_plotted_levels_outside_the_calibrated_range_are_marked(tmp_path: Path) -> None:
+    """A reached level that left its contact model's range is drawn ringed (it is split
+    out from the reached ones), a missed one as a cross; the figures are written."""
+    from tightknot.viz.sweep_figures import FIGURES, marked_levels, plot_tightness_sweep
+
+    def level(force, lam, reached=True, outside=False):
+        return {"case_id": "c", "status": "ok", "knot": "open", "level_kind": "pull_force",
+                "reached": reached, "pull_force_N": force, "lambda_oc": lam,
+                "end_to_end_m": 0.1 + 0.01 * force, "stretch": 1.0 + 0.01 * force,
+                "min_area_ratio": 1.0 - 0.02 * force, "outside_calibrated_range": outside,
+                "length": 0.185, "nodes": 90}
+
+    rows = [level(2.0, 15.0), level(5.0, 11.0, outside=True), level(9.0, 9.0, reached=False)]
+    ok, missed, outside = marked_levels(rows, "lambda_oc", "pull_force_N")
+    assert [r["pull_force_N"] for r in ok] == [2.0, 5.0]
+    assert [r["pull_force_N"] for r in missed] == [9.0]
+    assert [r["pull_force_N"] for r in outside] == [5.0]
+    paths = plot_tightness_sweep(rows, ["length", "nodes"], tmp_path / "figs")
+    assert sorted(p.name for p in paths) == sorted(FIGURES)
+    assert all(p.stat().st_size > 0 for p in paths)

@@ -3,7 +3,10 @@
 Rows are those of :func:`tightknot.sweep.table.table_rows` (plain dicts), one line per
 case: pulling force against Lambda_OC, force against end-to-end distance (the
 force-extension curve), and stretch and min A/A0 against force. A missed level is drawn
-as a cross at its last good state, so a gap in a curve is visible as such.
+as a cross at its last good state, so a gap in a curve is visible as such; a reached level
+that left the range its contact model was calibrated or judged in (the row's
+``outside_calibrated_range``) is ringed, so an extrapolated point does not pass for a
+judged one.
 """
 
 from __future__ import annotations
@@ -29,6 +32,17 @@ def _cases(rows: Sequence[Mapping[str, Any]]) -> dict[str, list[Mapping[str, Any
         if r.get("level_kind") is not None:
             out.setdefault(r["case_id"], []).append(r)
     return out
+
+
+def marked_levels(levels: Sequence[Mapping[str, Any]], xkey: str, ykey: str
+                  ) -> tuple[list[Mapping[str, Any]], list[Mapping[str, Any]],
+                             list[Mapping[str, Any]]]:
+    """One case's levels that have both values: (reached, missed, reached but outside the
+    calibrated range)."""
+    has = [r for r in levels if r.get(xkey) is not None and r.get(ykey) is not None]
+    ok = [r for r in has if r["reached"]]
+    return (ok, [r for r in has if not r["reached"]],
+            [r for r in ok if r.get("outside_calibrated_range")])
 
 
 def case_legends(rows: Sequence[Mapping[str, Any]], params: Sequence[str]) -> dict[str, str]:
@@ -63,15 +77,16 @@ def plot_tightness_sweep(rows: Sequence[Mapping[str, Any]], params: Sequence[str
 
     def draw(ax: Any, xkey: str, ykey: str, xscale: float = 1.0) -> None:
         for cid, levels in cases.items():
-            ok = [r for r in levels if r["reached"] and r.get(xkey) is not None
-                  and r.get(ykey) is not None]
+            ok, missed, outside = marked_levels(levels, xkey, ykey)
             line, = ax.plot([r[xkey] * xscale for r in ok], [r[ykey] for r in ok], "o-",
                             ms=4, label=legends[cid])
-            missed = [r for r in levels if not r["reached"] and r.get(xkey) is not None
-                      and r.get(ykey) is not None]
             if missed:
                 ax.plot([r[xkey] * xscale for r in missed], [r[ykey] for r in missed], "x",
                         color=line.get_color(), ms=8, label=f"{legends[cid]}: not reached")
+            if outside:
+                ax.plot([r[xkey] * xscale for r in outside], [r[ykey] for r in outside], "o",
+                        mfc="none", color=line.get_color(), ms=10,
+                        label=f"{legends[cid]}: outside the calibrated range")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
 
