@@ -53,10 +53,10 @@ def main() -> None:
         spread[other["mesh"]["level"]] = other
     rec = area_range(fem, spread=spread)
     print("T/(E D0^2)  approach  force    A/A0 FEM  rod   points  L_c FEM  rod   kappa   met")
-    rows = rec["levels"] + rec["past_approach_limit"]
-    for t, row in zip(rec["tension_over_e_d0sq"], rows, strict=True):
-        judged = ("yes" if all(row["met"].values()) else "no") if row in rec["levels"] \
-            else f"(past {APPROACH_LIMIT} D0: not judged)"
+    past = f"(past {APPROACH_LIMIT} D0: not judged)"
+    rows = ([(row, "yes" if all(row["met"].values()) else "no") for row in rec["levels"]]
+            + [(row, past) for row in rec["past_approach_limit"]])
+    for t, (row, judged) in zip(rec["tension_over_e_d0sq"], rows, strict=True):
         print(f"{t:9.4f}  {row['approach_over_d0']:7.3f}  {row['force_rel']:+6.1%}  "
               f"{row['fem_area_ratio']:8.4f} {row['rod_area_ratio']:6.4f} "
               f"{100 * row['area_points']:+5.1f}   {row['fem_width_fraction']:6.3f} "

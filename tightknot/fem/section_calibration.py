@@ -152,15 +152,15 @@ def area_range(fem_wrap: dict[str, Any], section: Any = None,
                         ("force_per_length_mid_nominal", "force_per_length_mid"),
                         "kappa_d0_mid_nominal", width_scene="wrap", limit=limit)["levels"]
 
-    comp = {"levels": compared(APPROACH_LIMIT)}
-    past = compared(math.inf)[len(comp["levels"]):]
-    judged = judged_area_ratio(comp["levels"])
+    levels = compared(APPROACH_LIMIT)
+    past = compared(math.inf)[len(levels):]
+    judged = judged_area_ratio(levels)
+    at = None if judged is None else levels.index(judged)
     keys = ("approach_over_d0", "fem_force", "rod_force", "force_rel", "fem_area_ratio",
             "rod_area_ratio", "area_points", "curvature_rel", "fem_width_fraction",
             "rod_width_fraction", "width_fraction", "met")
     spread_rows = {}
-    if judged is not None:
-        at = comp["levels"].index(judged)
+    if at is not None:
         for mesh, other in (spread or {}).items():
             if len(other["steps"]) > at:
                 f, m = fem_wrap["steps"][at], other["steps"][at]
@@ -177,13 +177,12 @@ def area_range(fem_wrap: dict[str, Any], section: Any = None,
         "approach_limit_over_d0": APPROACH_LIMIT,
         "targets": TARGETS,
         "section_modes": section.max_mode,
-        "levels": [{k: row.get(k) for k in keys} for row in comp["levels"]],
+        "levels": [{k: row.get(k) for k in keys} for row in levels],
         # past the approach limit: reported, not judged (the targets' range ends there)
         "past_approach_limit": [{k: row.get(k) for k in keys} for row in past],
         "judged_area_ratio": None if judged is None else judged["fem_area_ratio"],
         "judged_tension_over_e_d0sq": (
-            None if judged is None
-            else fem_wrap["steps"][comp["levels"].index(judged)]["tension_over_e_d0sq"]),
+            None if at is None else fem_wrap["steps"][at]["tension_over_e_d0sq"]),
         "mesh_spread_at_judged_level": spread_rows,
         "fem_wall_time_s": fem_wrap["wall_time_s"],
         "rod_wall_time_s": rod["wall_time_s"],
