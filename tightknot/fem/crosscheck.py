@@ -76,7 +76,7 @@ import math
 import time
 from typing import Any
 
-from .crosscheck_soft import fem_spread, spread_mesh
+from .crosscheck_soft import fem_runs, fem_spread, spread_mesh
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .material import ROD_DIAMETER
 from .rod_model import EDGES_PER_D0, check_edges_per_d0, rod_indent, rod_wrap
@@ -385,8 +385,6 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     their own ``wall_time_s`` then enters the ratio. Returns the JSON-serialisable report
     (module docstring): per-scene comparisons, ``fem_over_rod_time_ratio``, ``passed``.
     """
-    from . import run_scene
-
     if mesh not in MESH_LEVELS:
         raise ValueError(f"mesh must be one of {MESH_LEVELS}, got {mesh!r}")
     if contact not in CONTACT_LEVELS:
@@ -401,22 +399,14 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     elif rod_edges_per_d0 != EDGES_PER_D0:
         raise ValueError(f"rod_edges_per_d0 is a setting of the sectioned level's rod scenes "
                          f"(contact sectioned), got contact {contact!r}")
-    fem_results = dict(fem_results or {})
     start = time.perf_counter()
-    if "indent" not in fem_results:
-        fem_results["indent"] = run_scene("indent", mesh=mesh, convergence=False)
-    if "wrap" not in fem_results:
-        fem_results["wrap"] = run_scene("wrap", mesh=mesh, convergence=False)
+    # each scene on ``mesh`` and, for the FEM's own spread beside each compared level, on
+    # the next coarser mesh
+    fem_results = fem_runs(mesh, fem_results, ("indent", "wrap"))
     fem_ind, fem_wrap = fem_results["indent"], fem_results["wrap"]
-    # the FEM's own spread beside each compared level: the next coarser mesh's run
     coarser = spread_mesh(mesh)
-    spread: dict[str, list[dict] | None] = {"indent": None, "wrap": None}
-    if coarser is not None:
-        for name in ("indent", "wrap"):
-            key = f"{name}@{coarser}"
-            if key not in fem_results:
-                fem_results[key] = run_scene(name, mesh=coarser, convergence=False)
-            spread[name] = fem_results[key]["steps"]
+    spread = {name: None if coarser is None else fem_results[f"{name}@{coarser}"]["steps"]
+              for name in ("indent", "wrap")}
     if contact == "sectioned":
         report = _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift,
                                    thinning, rod_edges_per_d0, spread)
@@ -425,7 +415,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
         if soft:
             from tightknot.contact.sectioned import SectionSettings
 
-            from .crosscheck_soft import fem_runs, soft_rows
+            from .crosscheck_soft import soft_rows
 
             fem_results = fem_runs(mesh, fem_results)
             section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift,
@@ -497,7 +487,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
                         if k in ("indent", "wrap") or k.startswith(("indent@", "wrap@"))},
     }
     if soft:
-        from .crosscheck_soft import fem_runs, soft_rows
+        from .crosscheck_soft import soft_rows
 
         fem_results = fem_runs(mesh, fem_results)
         report["soft_scenes"] = soft_rows(mesh, fem_results)

@@ -80,15 +80,17 @@ def spread_mesh(mesh: str) -> str | None:
     return MESH_LEVELS[k - 1] if k > 0 else None
 
 
-def fem_runs(mesh: str, fem_results: dict[str, dict] | None = None) -> dict[str, dict]:
-    """The FEM results the soft rows need: each soft scene on ``mesh`` (keys "soft_wrap",
-    "clasp") and on the spread mesh (keys "soft_wrap@coarse" ...); those in
-    ``fem_results`` are reused, the others run with the scenes' default load levels."""
+def fem_runs(mesh: str, fem_results: dict[str, dict] | None = None,
+             scenes: tuple[str, ...] = ROW_SCENES) -> dict[str, dict]:
+    """The FEM results a comparison needs: each of ``scenes`` (default the soft rows',
+    :data:`ROW_SCENES`) on ``mesh`` (keys "soft_wrap", ...) and on the spread mesh (keys
+    "soft_wrap@coarse" ...); those in ``fem_results`` are reused, the others run with the
+    scenes' default load levels."""
     from . import run_scene
 
     out = dict(fem_results or {})
     spread = spread_mesh(mesh)
-    for name in ROW_SCENES:
+    for name in scenes:
         for level, key in ((mesh, name), (spread, f"{name}@{spread}")):
             if level is None or key in out:
                 continue
