@@ -39,6 +39,7 @@ def test_compare_arithmetic_gating_and_spread():
     assert row["area_points"] == pytest.approx(-0.01)
     assert row["fem_spread_rel"]["force"] == pytest.approx(2.0 / 2.2 - 1.0)
     assert row["met"] == {"force": True, "area": True, "converged": True}
+    assert row["load"] == 0.5  # the clamp travel over D0
     # the diagnostic with the U's kinematics matched: 1.9 against 2.0
     assert row["force_rel_kinematics_matched"] == pytest.approx(-0.05)
     assert "curvature" not in row["met"]  # the clasp's curvature is reported only

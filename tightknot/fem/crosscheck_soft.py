@@ -116,45 +116,63 @@ def clasp_kinematic_offset(fem_relaxed: dict[str, float], rod: dict[str, Any]
             "clamp_travel_over_d0": 2.0 * (shift + inner)}
 
 
-def _rod_runs(fem: dict[str, dict], contact: Any) -> dict[str, dict]:
-    """The rod model at the FEM's load levels and parameters, at level ``contact``; with
-    the FEM's relaxed U's at hand also the clasp with the kinematics matched (key
-    "clasp_matched", its ``kinematic_offset``, :func:`clasp_kinematic_offset`)."""
+def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_SCENES
+             ) -> dict[str, dict]:
+    """The rod model of ``scenes`` (default the soft rows', :data:`ROW_SCENES`) at the FEM's
+    load levels and parameters (``fem`` holds each scene's FEM result), at level
+    ``contact``; with the clasp and the FEM's relaxed U's at hand also the clasp with the
+    kinematics matched (key "clasp_matched", its ``kinematic_offset``,
+    :func:`clasp_kinematic_offset`)."""
     from .rod_model_soft import rod_clasp, rod_soft_crossing, rod_soft_wrap
 
-    wp = fem["soft_wrap"]["parameters"]
-    cp = fem["clasp"]["parameters"]
-    xp = fem["soft_crossing"]["parameters"]
-    d0 = cp["diameter_m"]
+    unknown = [name for name in scenes if name not in ROW_SCENES]
+    if unknown:
+        raise ValueError(f"rod_runs: scenes must be among {ROW_SCENES}, got {unknown}")
+
+    def soft_wrap() -> dict[str, Any]:
+        wp = fem["soft_wrap"]["parameters"]
+        return rod_soft_wrap([s["tension"] for s in fem["soft_wrap"]["steps"]],
+                             wrap_angle_deg=wp["wrap_angle_deg"], diameter=wp["diameter_m"],
+                             youngs_modulus=wp["youngs_modulus_pa"],
+                             length_over_d0=wp["segment_length_m"] / wp["diameter_m"],
+                             contact=contact)
 
     def clasp(gap: float) -> dict[str, Any]:
+        cp = fem["clasp"]["parameters"]
+        d0 = cp["diameter_m"]
         return rod_clasp([s["pull_over_d0"] * d0 for s in fem["clasp"]["steps"]],
                          bend_radius_over_d0=cp["bend_radius_m"] / d0,
                          leg_length_over_d0=cp["leg_length_m"] / d0, diameter=d0,
                          youngs_modulus=cp["youngs_modulus_pa"], contact=contact,
                          initial_gap=gap)
 
-    runs = {
-        "soft_wrap": rod_soft_wrap([s["tension"] for s in fem["soft_wrap"]["steps"]],
-                                   wrap_angle_deg=wp["wrap_angle_deg"],
-                                   diameter=wp["diameter_m"],
-                                   youngs_modulus=wp["youngs_modulus_pa"],
-                                   length_over_d0=wp["segment_length_m"] / wp["diameter_m"],
-                                   contact=contact),
-        "clasp": clasp(cp["initial_gap_m"]),
-        "soft_crossing": rod_soft_crossing(
+    def fem_gap_clasp() -> dict[str, Any]:
+        return clasp(fem["clasp"]["parameters"]["initial_gap_m"])
+
+    def soft_crossing() -> dict[str, Any]:
+        xp = fem["soft_crossing"]["parameters"]
+        return rod_soft_crossing(
             [s["w_over_d0"] * xp["diameter_m"] for s in fem["soft_crossing"]["steps"]],
             diameter=xp["diameter_m"], youngs_modulus=xp["youngs_modulus_pa"],
-            length_over_d0=xp["segment_length_m"] / xp["diameter_m"], contact=contact),
-    }
-    relaxed = fem["clasp"].get("relaxed")
+            length_over_d0=xp["segment_length_m"] / xp["diameter_m"], contact=contact)
+
+    build = {"soft_wrap": soft_wrap, "clasp": fem_gap_clasp, "soft_crossing": soft_crossing}
+    runs = {name: build[name]() for name in ROW_SCENES if name in scenes}
+    relaxed = fem["clasp"].get("relaxed") if "clasp" in runs else None
     if relaxed is not None and runs["clasp"]["relaxed"]:
         offset = clasp_kinematic_offset(relaxed, runs["clasp"])
         # the clamps moved in by the offset: the bends start that much closer
-        runs["clasp_matched"] = clasp(cp["initial_gap_m"] - offset["clamp_travel_over_d0"] * d0)
+        cp = fem["clasp"]["parameters"]
+        runs["clasp_matched"] = clasp(cp["initial_gap_m"]
+                                      - offset["clamp_travel_over_d0"] * cp["diameter_m"])
         runs["clasp_matched"]["kinematic_offset"] = offset
     return runs
 
+
+#: Per scene: the key of a step's load level (the soft wrap's tension over E D0^2, the
+#: clasp's clamp travel over D0, the crossing's approach per rod over D0).
+LOAD_KEYS: dict[str, str] = {"soft_wrap": "tension_over_e_d0sq", "clasp": "pull_over_d0",
+                             "soft_crossing": "w_over_d0"}
 
 #: Per scene: (FEM force key, rod force key, FEM area key, rod area key, FEM curvature key,
 #: rod curvature key (None: no curvature), whether the curvature has a target).
@@ -183,7 +201,7 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
         if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9 or f["peak_pressure_over_e"] <= 0.0:
             continue
         row = {
-            "load": f.get("tension_over_e_d0sq", f.get("pull_over_d0")),
+            "load": f[LOAD_KEYS[scene]],
             "approach_over_d0": f["approach_over_d0"],
             "fem_force": f[f_key], "rod_force": r[r_key],
             "force_rel": relative(r[r_key], f[f_key]),
@@ -232,7 +250,7 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
     levels = {}
     for contact in names:
         start = time.perf_counter()
-        rod = _rod_runs(fem, section if (contact == "sectioned" and section is not None)
+        rod = rod_runs(fem, section if (contact == "sectioned" and section is not None)
                         else contact)
         scenes = {}
         for name in ROW_SCENES:

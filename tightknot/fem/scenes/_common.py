@@ -79,6 +79,40 @@ def convergence_table(run: Callable[[str], dict[str, Any]], keys: Sequence[str],
     return table, results
 
 
+def level_table(results: dict[str, dict[str, Any]], keys: Sequence[str], load_key: str
+                ) -> list[dict[str, Any]]:
+    """The three-mesh table at every load level: ``results`` maps mesh levels (of
+    :data:`MESH_LEVELS`) to results of one scene at the same load levels (each step's
+    ``load_key``, equal to 1e-12 relative); per level the finest mesh's values of ``keys``
+    and each other mesh's relative difference to them (as :func:`convergence_table` at the
+    last level). A key a result lacks is None."""
+    meshes = [m for m in MESH_LEVELS if m in results]
+    if len(meshes) != len(results) or len(meshes) < 2:
+        raise ValueError(f"level_table: results on two or more of {MESH_LEVELS} needed, "
+                         f"got {sorted(results)}")
+    finest = results[meshes[-1]]["steps"]
+    if any(len(results[m]["steps"]) != len(finest) for m in meshes):
+        raise ValueError("level_table: the meshes' results have different load levels "
+                         f"({[len(results[m]['steps']) for m in meshes]} steps)")
+    for m in meshes:
+        for a, b in zip(results[m]["steps"], finest, strict=True):
+            if abs(relative(a[load_key], b[load_key])) > 1e-12:
+                raise ValueError(f"level_table: {m}'s {load_key} {a[load_key]!r} is not the "
+                                 f"{meshes[-1]} mesh's {b[load_key]!r}")
+    rows = []
+    for k, top in enumerate(finest):
+        row: dict[str, Any] = {"step": k, "finest": meshes[-1], "load": top[load_key],
+                               "values": {key: top.get(key) for key in keys}, "relative": {}}
+        for m in meshes[:-1]:
+            other = results[m]["steps"][k]
+            row["relative"][m] = {
+                key: (relative(other[key], top[key])
+                      if other.get(key) is not None and top.get(key) is not None else None)
+                for key in keys}
+        rows.append(row)
+    return rows
+
+
 def mesh_convergence(run: Callable[[str], dict[str, Any]], keys: Sequence[str],
                      first: dict[str, Any], level: str, computed: bool) -> dict[str, Any]:
     """A scene result's ``mesh_convergence`` entry: the table of :func:`convergence_table`
