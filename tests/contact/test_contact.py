@@ -395,3 +395,37 @@ def test_the_step_bound_guards_a_pair_inside_the_exclusion_window() -> None:
     check = ProximityCheck(m, hard_fraction=0.05, local_fraction=LOCAL_FRACTION)
     for u in np.linspace(0.0, alpha, 11):
         assert not check.check(x + u * dx, rest).violated
+
+
+def test_mirror_images_are_no_candidates_and_cost_nothing_else() -> None:
+    # Three rods through one region: 0 and 1 declared one body's mirror images (a FEM
+    # stack's), 2 crossing both. Their pairs leave the candidates, which the energy, the
+    # step bound and the checks all read; rod 2's pairs with either stay, as before.
+    def model(mirror):
+        s = np.linspace(-3 * D, 3 * D, 13)
+        b = RodBuilder(twist=False)
+        b.add_rod(np.c_[s, 0 * s, 0 * s], D, Material(E, 0.5, 1160.0))
+        b.add_rod(np.c_[0 * s, s, 0 * s + 0.5 * D], D, Material(E, 0.5, 1160.0))
+        b.add_rod(np.c_[0 * s + 0.2 * D, 0 * s - 0.3 * D, s], D, Material(E, 0.5, 1160.0))
+        return b.finalize(mirror_rod_pairs=mirror)
+
+    def pairs(m):
+        cl = ContactLayer(m, LAW)
+        bp = cl.broad_phase
+        got = bp.candidates(bp.x_in.put(m.vertex_initial_position), bp.zero_dx,
+                            bp.interaction_margin, *bp.arcs(m.edge_rest_length)).numpy()
+        return {tuple(sorted(int(m.edge_rod[e]) for e in p)) for p in got}, cl
+
+    plain, _ = pairs(model(()))
+    mirrored, cl = pairs(model(((0, 1),)))
+    assert (0, 1) in plain and {(0, 2), (1, 2)} <= plain
+    assert mirrored == plain - {(0, 1)}
+    # rods 0 and 1 overlap by half a diameter: no energy between them
+    m = model(((0, 1),))
+    x = m.vertex_initial_position.copy()
+    x[m.rods[2].vertex_slice] += [10 * D, 0.0, 0.0]  # rod 2 away
+    assert cl.evaluate(x, m.edge_rest_length, False, False)[0] == 0.0
+    # and the step bound lets rod 1 move through rod 0
+    dx = np.zeros_like(x)
+    dx[m.rods[1].vertex_slice] = [0.0, 0.0, -D]
+    assert cl.max_step(x, dx, m.edge_rest_length) == 1.0

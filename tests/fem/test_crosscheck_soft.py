@@ -49,6 +49,27 @@ def test_compare_arithmetic_gating_and_spread():
     assert compare("clasp", fem, rod, None)["levels"][0]["fem_spread_rel"] is None
 
 
+def test_rod_b_area_is_compared_where_the_scene_has_two_rods_b():
+    # the soft wrap and the crossing compare B's mid-section area too (the FEM's stack and
+    # its rod model hold B alike); the clasp's U's are one another's images
+    def step(area_b, rod=False):
+        out = {"tension_over_e_d0sq": 0.03, "approach_over_d0": 0.1,
+               "force_per_length_mid_nominal": 1.0, "force_per_length_mid": 1.0,
+               "area_ratio_mid": 0.95, "area_ratio_mid_b": area_b,
+               "kappa_d0_mid_nominal": 0.5, "kappa_d0_mid": 0.5,
+               "peak_pressure_over_e": 0.2}
+        return {**out, "converged": True} if rod else out
+
+    out = compare("soft_wrap", [step(0.90)], [step(0.96, rod=True)], None)
+    row = out["levels"][0]
+    assert row["area_points_b"] == pytest.approx(0.06)
+    assert row["met"]["area_b"] is False and row["met"]["area"] is True
+    assert not out["passed"] and out["worst"]["area_points_b"] == pytest.approx(0.06)
+    assert compare("soft_wrap", [step(0.90)], [step(0.94, rod=True)], None)["passed"]
+    clasp = compare("clasp", [_fem_step(2.0, 0.1)], [_rod_step(2.0)], None)
+    assert "area_b" not in clasp["levels"][0]["met"] and clasp["worst"]["area_points_b"] is None
+
+
 def test_clasp_kinematic_offset():
     from tightknot.fem.crosscheck_soft import clasp_kinematic_offset
 

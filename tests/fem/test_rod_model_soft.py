@@ -42,9 +42,11 @@ def soft_wrap_rod():
 
 
 def test_soft_wrap_statics_and_shared_overlap(soft_wrap_rod):
-    # frictionless statics: the contact force on the held rod is 2 T sin(theta) (1e-6:
+    # frictionless statics: the contact force on the wrapped rod is 2 T sin(theta) (1e-6:
     # the Newton tolerance); the soft pair splits the overlap evenly, so at the same
-    # tension it overlaps more than a rod on a rigid cylinder (whose law is k 2^p)
+    # tension it overlaps more than a rod on a rigid cylinder (whose law is k 2^p); B is
+    # held as the FEM's stack holds it: pressed from both sides, its axis straight, free
+    # to stretch along it, so its pressed section thins further as the tension grows
     from tightknot.fem.rod_model import rod_wrap
 
     tensions, soft = soft_wrap_rod
@@ -56,6 +58,7 @@ def test_soft_wrap_statics_and_shared_overlap(soft_wrap_rod):
         assert s["overlap_over_d0"] > r["overlap_over_d0"]
         assert s["area_ratio_mid"] < 1.0 and s["area_ratio_mid_b"] < 1.0
         assert s["profile_a"][0]["contact_fraction"] > 0.0
+    assert soft["steps"][1]["area_ratio_mid_b"] < soft["steps"][0]["area_ratio_mid_b"]
 
 
 def test_clasp_rod_model_is_clamped_where_the_fem_clamps():

@@ -128,3 +128,39 @@ def test_a_solve_stops_when_an_accepted_state_fails_the_check() -> None:
     res = newton(system, system.free_vector(), NewtonOptions(max_iterations=200)).run()
     assert res.reason == "passed_through" and not res.converged
     assert "passes through itself" in system.violation and "edges" in system.violation
+
+
+def test_mirror_images_are_not_checked_but_every_other_pair_is() -> None:
+    # Three straight rods through one point: rods 0 and 1 declared one body's mirror
+    # images (a FEM stack's), rod 2 a real rod crossing both.
+    line = np.linspace(-2.0, 2.0, 9)[:, None] * D
+    zero = np.zeros_like(line)
+    b = RodBuilder(twist=False)
+    b.add_rod(np.c_[line, zero, zero], D, MAT)
+    b.add_rod(np.c_[zero, line, zero], D, MAT)
+    b.add_rod(np.c_[zero + 0.5 * D, zero + 0.5 * D, line], D, MAT)
+    m = b.finalize(mirror_rod_pairs=((1, 0),))
+    assert m.mirror_rod_pairs == ((0, 1),)
+    x = m.vertex_initial_position
+    p = ProximityCheck(m).check(x, m.edge_rest_length)
+    # rods 0 and 1 meet (distance 0) and are passed over; rod 2 runs 0.5 D off both
+    assert p.ratio == pytest.approx(0.5 / 0.045, rel=1e-9)
+    x2 = x.copy()
+    x2[m.rods[2].vertex_start:] -= [0.0, 0.5 * D, 0.0]  # now through rod 0's axis
+    p2 = ProximityCheck(m).check(x2, m.edge_rest_length)
+    assert p2.violated and p2.distance == 0.0
+    assert {int(m.edge_rod[e]) for e in p2.edges} in ({0, 2}, {1, 2})
+    # without the declaration the mirror images' meeting is a violation
+    b2 = RodBuilder(twist=False)
+    for r in m.rods:
+        b2.add_rod(x[r.vertex_start:r.vertex_start + r.vertex_count], D, MAT)
+    assert ProximityCheck(b2.finalize()).check(x, m.edge_rest_length).violated
+
+
+@pytest.mark.parametrize("pairs", [((0, 0),), ((0, 3),), ((-1, 1),)])
+def test_mirror_rod_pairs_must_name_two_rods(pairs) -> None:
+    b = RodBuilder(twist=False)
+    for k in range(3):
+        b.add_rod(np.c_[np.linspace(0, 1, 5), np.full(5, k), np.zeros(5)] * D, D, MAT)
+    with pytest.raises(ValueError, match="mirror_rod_pairs"):
+        b.finalize(mirror_rod_pairs=pairs)

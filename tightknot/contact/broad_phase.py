@@ -174,6 +174,8 @@ class BroadPhase:
         #: (rest lengths, window scale, their arc tables) of the last :meth:`arcs` call.
         self._arcs_memo: tuple[np.ndarray, np.ndarray, tuple[wp.array, wp.array]] | None = None
         self._launches = Launches()
+        #: Rods that are mirror images of each other (Model.mirror_rod_pairs), or None.
+        self._mirror = model.mirror_matrix() if model.mirror_rod_pairs else None
 
     def _alloc(self, capacity: int) -> None:
         self._pairs = wp.zeros(capacity, dtype=wp.vec2i, device=self.device)
@@ -235,7 +237,7 @@ class BroadPhase:
                       outputs=[self._count, self._pairs])
             n = int(self._count.numpy()[0])
             if n <= self._capacity:
-                return self._pairs[:n]
+                return self._pairs[:n] if self._mirror is None else self._without_mirrors(n)
             if n > MAX_CANDIDATES:
                 # Pairs per contact grow as (D/l)^2: a fine mesh of a knot whose strands
                 # touch over many diameters outgrows memory.
@@ -248,6 +250,20 @@ class BroadPhase:
             # Overflow: grow and query again, never drop a candidate.
             self._capacity = int(2 ** math.ceil(math.log2(n * 1.25)))
             self._alloc(self._capacity)
+
+    def _without_mirrors(self, n: int) -> wp.array:
+        """The first ``n`` candidates less the pairs of two mirror images
+        (:attr:`tightknot.rods.model.Model.mirror_rod_pairs`), as a prefix of the buffer."""
+        pairs = self._pairs.numpy()[:n]
+        rod = self.model.edge_rod
+        keep = ~self._mirror[rod[pairs[:, 0]], rod[pairs[:, 1]]]
+        if keep.all():
+            return self._pairs[:n]
+        kept = np.ascontiguousarray(pairs[keep])
+        if kept.shape[0]:
+            wp.copy(self._pairs, wp.array(kept, dtype=wp.vec2i, device=self.device),
+                    count=kept.shape[0])
+        return self._pairs[:kept.shape[0]]
 
     def buffer_of(self, pairs: wp.array) -> wp.array:
         """The candidate buffer itself when ``pairs`` is its prefix (as :meth:`candidates`

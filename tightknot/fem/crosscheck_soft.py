@@ -16,7 +16,8 @@ soft crossing force    the force between the two crossing rods at the       |rel
                        pressed from both sides,
                        :func:`tightknot.fem.rod_model_soft.soft_crossing_scene`)
 section area           A/A0 at the middle of the wrap / at the apex / at    |diff| <= 0.05
-                       the crossing
+                       the crossing; of rod B too (the wrap, the crossing;
+                       the clasp's U's are one another's images)
 curvature              soft wrap: kappa D0 of the axis at the middle        |rel| <= 10 %
                        (clasp: the apex's, reported only: the FEM's is the
                        section centroids', not the nominal axis's; the
@@ -186,6 +187,12 @@ _KEYS: dict[str, tuple[str, str, str, str, str | None, str | None, bool]] = {
 }
 
 
+#: Per scene: the key of rod B's mid-section A/A0, where B is compared too (the clasp's
+#: two U's are one another's images: its rod model reports one).
+_AREA_B_KEYS: dict[str, str] = {"soft_wrap": "area_ratio_mid_b",
+                                "soft_crossing": "area_ratio_mid_b"}
+
+
 def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
             spread_steps: list[dict] | None, matched_steps: list[dict] | None = None
             ) -> dict[str, Any]:
@@ -216,17 +223,24 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
             "rod_converged": bool(r["converged"]),
             "fem_spread_rel": fem_spread(f, c, f_key, fa_key, fk_key),
         }
+        b_key = _AREA_B_KEYS.get(scene)
+        if b_key is not None:
+            row.update({"fem_area_ratio_b": f[b_key], "rod_area_ratio_b": r[b_key],
+                        "area_points_b": r[b_key] - f[b_key]})
         if m is not None:
             row["rod_force_kinematics_matched"] = m[r_key]
             row["force_rel_kinematics_matched"] = relative(m[r_key], f[f_key])
         row["met"] = {"force": abs(row["force_rel"]) <= TARGETS["force_rel"],
                       "area": abs(row["area_points"]) <= TARGETS["area_points"],
                       "converged": row["rod_converged"]}
+        if b_key is not None:
+            row["met"]["area_b"] = abs(row["area_points_b"]) <= TARGETS["area_points"]
         if kappa_target:
             row["met"]["curvature"] = abs(row["curvature_rel"]) <= TARGETS["curvature_rel"]
         rows.append(row)
-    worst = {k: max((abs(x[k]) for x in rows if x[k] is not None), default=None)
-             for k in ("force_rel", "area_points", "curvature_rel", "pressure_rel")}
+    worst = {k: max((abs(x[k]) for x in rows if x.get(k) is not None), default=None)
+             for k in ("force_rel", "area_points", "area_points_b", "curvature_rel",
+                       "pressure_rel")}
     spreads = [x["fem_spread_rel"]["force"] for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
             "fem_force_spread_max": max((abs(s) for s in spreads), default=None),

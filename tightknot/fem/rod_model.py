@@ -124,11 +124,19 @@ WRAP_START_OVERLAP: float = 0.01
 
 
 def wrap_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
-               wrap_angle_deg: float, edges_per_d0: int = EDGES_PER_D0) -> RodScene:
+               wrap_angle_deg: float, edges_per_d0: int = EDGES_PER_D0,
+               stack: bool = False) -> RodScene:
     """The wrap scene's rods and constraints: a rod (axis e_z at rest) pulled by dead end
-    forces, the level load T [N] times (0, sin(theta), +-cos(theta)), around a pinned rod
-    along e_x above it at y = D0 - ``WRAP_START_OVERLAP`` D0 (:func:`wrap_constraints`);
-    ``edges_per_d0`` edges per D0 of rod, on both rods."""
+    forces, the level load T [N] times (0, sin(theta), +-cos(theta)), around a rod along
+    e_x above it at y = D0 - ``WRAP_START_OVERLAP`` D0 (:func:`wrap_constraints`);
+    ``edges_per_d0`` edges per D0 of rod, on both rods. The rod above is pinned (a rigid
+    cylinder's stand-in), or with ``stack`` held as the FEM's ``soft_wrap`` holds its rod
+    B, whose held mid-plane makes it a stack: B pressed by the wrapped rod from below and
+    by its mirror image from above (a third rod, mirrored about B's axis, with mirrored
+    loads and constraints), B's axis straight (y and z held at every vertex: the held
+    mid-plane and the symmetry plane z = 0), free to stretch along it but for its middle
+    vertex (the symmetry plane x = 0), so that its pressed section thins as the solid's
+    does."""
     from tightknot.loading.levels import LevelLoad
     from tightknot.rods.boundary import BoundaryConditions
     from tightknot.rods.builder import RodBuilder
@@ -149,12 +157,22 @@ def wrap_scene(diameter: float, youngs_modulus: float, length_over_d0: float,
     b.add_rod(_line_points(np.array([0, 0, -half]), np.array([0, 0, half]), n_rod), d0, mat)
     b.add_rod(_line_points(np.array([-2 * d0, y_obs, 0]), np.array([2 * d0, y_obs, 0]),
                            n_obs), d0, mat)
-    model = b.finalize()
+    if stack:
+        b.add_rod(_line_points(np.array([0, 2 * y_obs, -half]), np.array([0, 2 * y_obs, half]),
+                               n_rod), d0, mat)
+    # the wrapped rod and its mirror image: their tails cross in the plane x = 0
+    model = b.finalize(mirror_rod_pairs=((0, 2),) if stack else ())
     load = LevelLoad()
     bcs = BoundaryConditions(model)
     for k in range(n_obs + 1):
-        bcs.pin(1, k)
+        if stack:
+            bcs.fix_components(1, k, (1, 2))
+        else:
+            bcs.pin(1, k)
     mid = wrap_constraints(bcs, n_rod, theta, load)
+    if stack:
+        bcs.fix_components(1, n_obs // 2, (0,))
+        wrap_constraints(bcs, n_rod, theta, load, rod=2, side=-1.0)
     system = RodSystem(model, State.initial(model), bcs)
     return RodScene(system, load, n_rod, n_obs, mid, half, _vertices(model, 0, n_rod),
                     _vertices(model, 1, n_obs))
@@ -263,17 +281,19 @@ def rod_indent(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "vertices": int(model.vertex_count), "law": pair_law.source}
 
 
-def wrap_constraints(bcs: Any, n_rod: int, theta: float, load: LevelLoad) -> int:
-    """The wrapped rod's (rod 0, ``n_rod`` edges) constraints of the wrap scene: the plane
+def wrap_constraints(bcs: Any, n_rod: int, theta: float, load: LevelLoad, rod: int = 0,
+                     side: float = 1.0) -> int:
+    """The wrapped rod's (``rod``, ``n_rod`` edges) constraints of the wrap scene: the plane
     x = 0, the symmetry plane z = 0 at its middle vertex, and dead end forces
-    ``load(t)`` (0, sin(theta), +-cos(theta)) [N]. Returns the middle vertex."""
+    ``load(t)`` (0, ``side`` sin(theta), +-cos(theta)) [N] (``side`` -1: the mirror image
+    of a stack). Returns the middle vertex."""
     mid = n_rod // 2
     for k in range(n_rod + 1):
-        bcs.fix_components(0, k, (0,))  # symmetry plane x = 0
-    bcs.fix_components(0, mid, (2,))  # symmetry plane z = 0
-    s, c = math.sin(theta), math.cos(theta)
-    bcs.force(0, 0, lambda t: load(t) * np.array([0.0, s, -c]))
-    bcs.force(0, -1, lambda t: load(t) * np.array([0.0, s, c]))
+        bcs.fix_components(rod, k, (0,))  # symmetry plane x = 0
+    bcs.fix_components(rod, mid, (2,))  # symmetry plane z = 0
+    s, c = side * math.sin(theta), math.cos(theta)
+    bcs.force(rod, 0, lambda t: load(t) * np.array([0.0, s, -c]))
+    bcs.force(rod, -1, lambda t: load(t) * np.array([0.0, s, c]))
     return mid
 
 

@@ -115,7 +115,9 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
                   contact: str = "compliant") -> dict[str, Any]:
     """The soft wrap with the rod model: rod A (axis e_z at rest) pulled by dead end forces
     T (0, sin(theta), +-cos(theta)) [N] (``tension_levels``) around rod B along e_x, held
-    straight (the FEM scene's stack keeps B's axis straight), with the soft pair law.
+    as the FEM scene's stack holds it (:func:`tightknot.fem.rod_model.wrap_scene` with
+    ``stack``: B pressed by A and A's mirror image, its axis straight, free to stretch
+    along it), with the soft pair law.
 
     Returns per level the keys of :func:`tightknot.fem.rod_model.rod_wrap` (the mid line
     load per length of the centreline, curvature, approach, overlap, A/A0, peak pressure)
@@ -126,9 +128,9 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     start = time.perf_counter()
     check_contact(contact)
     d0 = diameter
-    # The rigid wrap's rods and constraints (B pinned: the FEM's stack keeps its axis
-    # straight); only the pair law differs.
-    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg)
+    # The rigid wrap's rods and constraints, B held as the FEM's stack holds it (a pinned
+    # B could not thin where it is pressed, as the solid's does).
+    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg, stack=True)
     system, load, model = scene.system, scene.load, scene.model
     n_rod, n_obs, mid, half = scene.n_rod, scene.n_obs, scene.mid, scene.half
     y_obs = d0 - WRAP_START_OVERLAP * d0
@@ -157,7 +159,8 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
             "approach_over_d0": (d0 - dist) / d0,
             "overlap_over_d0": float(rep.overlap[rod_v[mid]]) / d0,
             "axial_stretch_mid": float(voronoi / (2.0 * half / n_rod)),
-            "contact_force_total": float(np.linalg.norm(g[obs_v].sum(axis=0))),
+            # on A (B carries A's and its mirror image's, which cancel)
+            "contact_force_total": float(np.linalg.norm(g[rod_v].sum(axis=0))),
             "force_per_length_mid": f_mid,
             "force_per_length_mid_over_e_d0": f_mid / (youngs_modulus * d0),
             "kappa_d0_mid": float(bergou_curvature(xr, closed=False)[mid]) * d0,

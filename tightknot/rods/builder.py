@@ -143,10 +143,21 @@ class RodBuilder:
         )
         return len(self._rods) - 1
 
-    def finalize(self, device: str = "cpu") -> Model:
-        """Make the model and upload its arrays to Warp ``device`` ("cpu", "cuda:0")."""
+    def finalize(self, device: str = "cpu",
+                 mirror_rod_pairs: tuple[tuple[int, int], ...] = ()) -> Model:
+        """Make the model and upload its arrays to Warp ``device`` ("cpu", "cuda:0").
+        ``mirror_rod_pairs``: pairs of rods that are one body's mirror images in a
+        symmetric scene, never in contact (:attr:`Model.mirror_rod_pairs`)."""
         if not self._rods:
             raise ValueError("no rods: call add_rod() before finalize()")
+        pairs = []
+        for pair in mirror_rod_pairs:
+            a, b = (int(i) for i in pair)
+            if not (0 <= a < len(self._rods) and 0 <= b < len(self._rods) and a != b):
+                raise ValueError(f"mirror_rod_pairs: {pair!r} is not a pair of two of the "
+                                 f"{len(self._rods)} rods (indices 0 to "
+                                 f"{len(self._rods) - 1})")
+            pairs.append((min(a, b), max(a, b)))
         per = 4 if self.twist else 3
         rods: list[RodInfo] = []
         cols: dict[str, list[np.ndarray]] = {k: [] for k in (
@@ -239,6 +250,7 @@ class RodBuilder:
             vertex_initial_position=cat("pos", np.float64),
             joint_link_offset=cat("jlink", np.float64),
             device=str(device),
+            mirror_rod_pairs=tuple(sorted(set(pairs))),
         )
         model.upload()
         return model

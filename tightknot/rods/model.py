@@ -95,6 +95,11 @@ class Model:
         joint_link_offset: extra reference twist 2 pi k [rad] at the closing joint of a
             closed rod given ``link_offset=k`` turns of excess link (0 elsewhere).
         device: Warp device of the mirrored arrays.
+        mirror_rod_pairs: pairs of rods (a < b) that stand for one body's mirror images in
+            a symmetric scene (a stack that the FEM holds on a symmetry plane,
+            :func:`tightknot.fem.rod_model.wrap_scene`): they are not material to each
+            other, so they are neither contact candidates nor checked for proximity.
+            Empty for every knot.
     """
 
     rods: list[RodInfo]
@@ -120,6 +125,7 @@ class Model:
     vertex_initial_position: np.ndarray
     joint_link_offset: np.ndarray
     device: str = "cpu"
+    mirror_rod_pairs: tuple[tuple[int, int], ...] = ()
     wp_arrays: dict[str, wp.array] = field(default_factory=dict, repr=False)
 
     @property
@@ -151,6 +157,14 @@ class Model:
             cached = (key, table)
             self.__dict__["_position_dofs"] = cached
         return cached[1]
+
+    def mirror_matrix(self) -> np.ndarray:
+        """Whether rods a and b are mirror images (:attr:`mirror_rod_pairs`), (rod count,
+        rod count) bool, symmetric."""
+        out = np.zeros((len(self.rods), len(self.rods)), dtype=np.bool_)
+        for a, b in self.mirror_rod_pairs:
+            out[a, b] = out[b, a] = True
+        return out
 
     def wp(self, name: str) -> wp.array:
         """The Warp mirror of host array ``name`` on the model's device."""

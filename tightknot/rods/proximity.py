@@ -5,7 +5,9 @@ pair it watches comes closer than its hard limit. This check does not trust it: 
 accepted iterate it measures the segment distance of *every* pair of edges that share no
 vertex (through a uniform grid of cells, in its own code), and reports the closest pair
 against a floor, so that a pair any part of the contact model skips is named the moment it
-comes too close, not found later as a changed knot type.
+comes too close, not found later as a changed knot type. Only two rods that stand for one
+body's mirror images (``Model.mirror_rod_pairs``, a FEM scene's stack) are not material to
+each other and not checked.
 
 Floor of a pair of edges of one rod whose nearest ends are an arc length s apart (rest
 lengths): ``min(hard, local * D sin(min(s / D, pi / 2)))``; D sin(s/D) is the chord between
@@ -102,7 +104,7 @@ def _segment_distance(p0, p1, q0, q1):
 
 
 @numba.njit(cache=True)
-def _closest(x, ev, rod, closed, rod_len, arc0, arc1, diam, cell, hard, local):
+def _closest(x, ev, rod, closed, rod_len, arc0, arc1, diam, cell, hard, local, mirror):
     ne = ev.shape[0]
     mid = np.empty((ne, 3))
     for j in range(ne):
@@ -135,6 +137,8 @@ def _closest(x, ev, rod, closed, rod_len, arc0, arc1, diam, cell, hard, local):
                         va0, va1, vb0, vb1 = ev[a, 0], ev[a, 1], ev[b, 0], ev[b, 1]
                         if va0 == vb0 or va0 == vb1 or va1 == vb0 or va1 == vb1:
                             continue
+                        if mirror[rod[a], rod[b]]:
+                            continue  # mirror images of one body (Model.mirror_rod_pairs)
                         big = max(diam[a], diam[b])
                         floor = hard * big
                         sep = np.inf
@@ -174,6 +178,7 @@ class ProximityCheck:
         self._rod = model.edge_rod.astype(np.int64)
         self._closed = np.array([r.closed for r in model.rods], dtype=np.bool_)
         self._diam = 2.0 * model.edge_radius.astype(np.float64)
+        self._mirror = model.mirror_matrix()
 
     def check(self, x: np.ndarray, rest: np.ndarray) -> Proximity:
         """The closest pair of positions ``x`` [m] relative to its floor, with edge rest
@@ -196,6 +201,7 @@ class ProximityCheck:
         cell = float(e.max() + self.hard_fraction * self._diam.max())
         ratio, a, b, dist, floor, sep = _closest(
             np.ascontiguousarray(x, dtype=np.float64), self._ev, self._rod, self._closed,
-            lengths, arc0, arc1, self._diam, cell, self.hard_fraction, self.local_fraction)
+            lengths, arc0, arc1, self._diam, cell, self.hard_fraction, self.local_fraction,
+            self._mirror)
         return Proximity(float(ratio), (int(a), int(b)), float(dist), float(floor),
                          float(sep))
