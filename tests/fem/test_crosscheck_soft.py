@@ -9,7 +9,12 @@ import pytest
 pytest.importorskip("felupe")
 
 from tightknot.fem.crosscheck import APPROACH_LIMIT, TARGETS  # noqa: E402
-from tightknot.fem.crosscheck_soft import compare, soft_rows, spread_mesh  # noqa: E402
+from tightknot.fem.crosscheck_soft import (  # noqa: E402
+    compare,
+    rod_runs,
+    soft_rows,
+    spread_mesh,
+)
 
 
 def _fem_step(force, approach, area=0.95, kappa=0.5, pull=0.5):
@@ -82,6 +87,11 @@ def test_clasp_kinematic_offset():
     assert off["apex_shift_over_d0"] == pytest.approx(0.02)
     assert off["inner_side_over_d0"] == pytest.approx(0.04)
     assert off["clamp_travel_over_d0"] == pytest.approx(0.12)
+
+
+def test_rod_runs_names_an_unknown_scene():
+    with pytest.raises(ValueError, match="scenes must be among"):
+        rod_runs({}, "compliant", scenes=("soft_warp",))
 
 
 def test_spread_mesh_is_the_next_coarser():
