@@ -997,7 +997,8 @@ class SectionedLayer(ContactLayer):
           samples penetrate a partner (any), over the boundary's length, at the vertex's
           edges' Gauss circles (the larger of the vertex's edges);
         * ``peak_pressure_over_E``, ``mean_pressure_over_E``: the penalty's pressure
-          kappa pen over E at those samples, largest and mean;
+          kappa pen over E at those samples, largest and mean (one sample's largest
+          penalty: an upper estimate of the solid's peak, docs/fem_crosscheck.md);
         * ``force_per_length``: the contact force per unit rest length [N/m] (sum of the
           samples' kappa pen times their rest area, over the edge);
         * ``half_width``: L_c pi D0 / 4 [m], the half-width of each of two opposite
