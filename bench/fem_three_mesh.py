@@ -16,6 +16,7 @@ FEM's own change with the mesh.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 import time
@@ -39,10 +40,8 @@ def scene_results(paths: list[Path], scene: str) -> dict[str, dict[str, Any]]:
 
 
 def _headline(scene: str) -> tuple[str, ...]:
-    from tightknot.fem.scenes import clasp, soft_crossing, soft_wrap
-
-    return {"soft_wrap": soft_wrap, "soft_crossing": soft_crossing,
-            "clasp": clasp}[scene].HEADLINE_KEYS
+    """The keys the scene's own module compares across meshes."""
+    return importlib.import_module(f"tightknot.fem.scenes.{scene}").HEADLINE_KEYS
 
 
 def run(scene: str, paths: list[Path], rod: str | None) -> dict[str, Any]:

@@ -254,7 +254,7 @@ class BroadPhase:
     def _without_mirrors(self, n: int) -> wp.array:
         """The first ``n`` candidates less the pairs of two mirror images
         (:attr:`tightknot.rods.model.Model.mirror_rod_pairs`), as a prefix of the buffer."""
-        pairs = self._pairs.numpy()[:n]
+        pairs = self._pairs[:n].numpy()
         rod = self.model.edge_rod
         keep = ~self._mirror[rod[pairs[:, 0]], rod[pairs[:, 1]]]
         if keep.all():

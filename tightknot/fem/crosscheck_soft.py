@@ -138,17 +138,16 @@ def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_S
                              length_over_d0=wp["segment_length_m"] / wp["diameter_m"],
                              contact=contact)
 
-    def clasp(gap: float) -> dict[str, Any]:
+    def clasp(gap: float | None = None) -> dict[str, Any]:
+        # gap None: the FEM's own initial gap
         cp = fem["clasp"]["parameters"]
         d0 = cp["diameter_m"]
+        gap = cp["initial_gap_m"] if gap is None else gap
         return rod_clasp([s["pull_over_d0"] * d0 for s in fem["clasp"]["steps"]],
                          bend_radius_over_d0=cp["bend_radius_m"] / d0,
                          leg_length_over_d0=cp["leg_length_m"] / d0, diameter=d0,
                          youngs_modulus=cp["youngs_modulus_pa"], contact=contact,
                          initial_gap=gap)
-
-    def fem_gap_clasp() -> dict[str, Any]:
-        return clasp(fem["clasp"]["parameters"]["initial_gap_m"])
 
     def soft_crossing() -> dict[str, Any]:
         xp = fem["soft_crossing"]["parameters"]
@@ -157,7 +156,7 @@ def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_S
             diameter=xp["diameter_m"], youngs_modulus=xp["youngs_modulus_pa"],
             length_over_d0=xp["segment_length_m"] / xp["diameter_m"], contact=contact)
 
-    build = {"soft_wrap": soft_wrap, "clasp": fem_gap_clasp, "soft_crossing": soft_crossing}
+    build = {"soft_wrap": soft_wrap, "clasp": clasp, "soft_crossing": soft_crossing}
     runs = {name: build[name]() for name in ROW_SCENES if name in scenes}
     relaxed = fem["clasp"].get("relaxed") if "clasp" in runs else None
     if relaxed is not None and runs["clasp"]["relaxed"]:
