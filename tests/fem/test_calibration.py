@@ -81,3 +81,30 @@ def test_coarse_recalibration_agrees_with_shipped_law(shipped):
     for name, tol in COARSE_TOLERANCE.items():
         diff = np.max(np.abs(_law(coarse, name, w) / _law(shipped, name, w) - 1.0))
         assert diff < tol, f"{name}: {diff:.3f} >= {tol}"
+
+
+def test_soft_crossing_point_law_recovers_a_power_law_and_replaces_only_the_point_law():
+    from dataclasses import fields
+
+    from tightknot.contact.law import RadialComplianceLaw
+    from tightknot.fem.calibration import soft_crossing_point_law, with_point_law
+
+    w = np.array([0.01, 0.04, 0.09, 0.15, 0.2])  # the last lies past the fitted range
+    steps = [{"w_over_d0": x, "force_over_e_d0sq": 3.8 * x**1.65,
+              "semi_axis_axial_over_d0": 1.2 * x**0.52,
+              "peak_pressure_over_e": 1.3 * x**0.6} for x in w]
+    steps[-1]["force_over_e_d0sq"] = 1e3  # would spoil the fit if it were read
+    fit = soft_crossing_point_law({"steps": steps, "mesh": {"level": "coarse"}})
+    assert fit["w_hat"] == pytest.approx(w[:4].tolist())
+    for k, p, kv, pv in (("k_point", "p_point", 3.8, 1.65), ("k_patch", "p_patch", 1.2, 0.52),
+                         ("k_pmax_point", "p_pmax_point", 1.3, 0.6)):
+        assert fit[k] == pytest.approx(kv, rel=1e-9) and fit[p] == pytest.approx(pv, rel=1e-9)
+    assert max(fit["residuals"].values()) < 1e-9
+    shipped = RadialComplianceLaw.from_json()
+    refit = with_point_law(shipped, fit, "a test")
+    changed = {f.name for f in fields(shipped)
+               if getattr(shipped, f.name) != getattr(refit, f.name)}
+    assert changed == {"k_point", "p_point", "k_patch", "p_patch", "k_pmax_point",
+                       "p_pmax_point", "source"}
+    with pytest.raises(ValueError, match="two or more load steps"):
+        soft_crossing_point_law({"steps": steps[:1]})

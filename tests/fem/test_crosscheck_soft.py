@@ -94,6 +94,36 @@ def test_rod_runs_names_an_unknown_scene():
         rod_runs({}, "compliant", scenes=("soft_warp",))
 
 
+def test_rod_runs_takes_a_pair_law(soft_crossing_one_level):
+    # the compliant level with the point law refitted on the soft crossing (bench/
+    # crossing_law.py): the same stack, a stiffer point law, a larger force; the shipped
+    # law carries about 0.6 of the FEM's force there, the refit its own fit (within 10 %)
+    from tightknot.contact.law import RadialComplianceLaw
+    from tightknot.fem.calibration import soft_crossing_point_law, with_point_law
+
+    fem = {"soft_crossing": soft_crossing_one_level}
+    refit = with_point_law(RadialComplianceLaw.from_json(),
+                           soft_crossing_point_law(_two_levels(soft_crossing_one_level)),
+                           "the coarse soft crossing")
+    shipped = rod_runs(fem, "compliant", scenes=("soft_crossing",))["soft_crossing"]
+    stiffer = rod_runs(fem, "compliant", scenes=("soft_crossing",),
+                       law=refit)["soft_crossing"]
+    f_fem = soft_crossing_one_level["steps"][0]["force"]
+    assert shipped["steps"][0]["force"] / f_fem == pytest.approx(0.62, abs=0.1)
+    assert stiffer["steps"][0]["force"] / f_fem == pytest.approx(1.0, abs=0.1)
+
+
+def _two_levels(result):
+    """A one-level scene result as two: the fit needs two levels, and the one level's
+    force with the medium mesh's exponent (1.65, bench/crossing_law.py) gives a second."""
+    s = result["steps"][0]
+    half = {"w_over_d0": s["w_over_d0"] / 2.0,
+            "force_over_e_d0sq": s["force_over_e_d0sq"] / 2.0**1.65,
+            "semi_axis_axial_over_d0": s["semi_axis_axial_over_d0"] / 2.0**0.5,
+            "peak_pressure_over_e": s["peak_pressure_over_e"] / 2.0**0.6}
+    return {"steps": [half, s], "mesh": result["mesh"]}
+
+
 def test_spread_mesh_is_the_next_coarser():
     assert spread_mesh("medium") == "coarse" and spread_mesh("fine") == "medium"
     assert spread_mesh("coarse") is None

@@ -117,11 +117,12 @@ def clasp_kinematic_offset(fem_relaxed: dict[str, float], rod: dict[str, Any]
             "clamp_travel_over_d0": 2.0 * (shift + inner)}
 
 
-def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_SCENES
-             ) -> dict[str, dict]:
+def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_SCENES,
+             law: Any = None) -> dict[str, dict]:
     """The rod model of ``scenes`` (default the soft rows', :data:`ROW_SCENES`) at the FEM's
     load levels and parameters (``fem`` holds each scene's FEM result), at level
-    ``contact``; with the clasp and the FEM's relaxed U's at hand also the clasp with the
+    ``contact`` (a compliant or smoothed level with the pair law ``law``, default the
+    shipped one); with the clasp and the FEM's relaxed U's at hand also the clasp with the
     kinematics matched (key "clasp_matched", its ``kinematic_offset``,
     :func:`clasp_kinematic_offset`)."""
     from .rod_model_soft import rod_clasp, rod_soft_crossing, rod_soft_wrap
@@ -136,7 +137,7 @@ def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_S
                              wrap_angle_deg=wp["wrap_angle_deg"], diameter=wp["diameter_m"],
                              youngs_modulus=wp["youngs_modulus_pa"],
                              length_over_d0=wp["segment_length_m"] / wp["diameter_m"],
-                             contact=contact)
+                             contact=contact, law=law)
 
     def clasp(gap: float | None = None) -> dict[str, Any]:
         # gap None: the FEM's own initial gap
@@ -147,14 +148,15 @@ def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_S
                          bend_radius_over_d0=cp["bend_radius_m"] / d0,
                          leg_length_over_d0=cp["leg_length_m"] / d0, diameter=d0,
                          youngs_modulus=cp["youngs_modulus_pa"], contact=contact,
-                         initial_gap=gap)
+                         initial_gap=gap, law=law)
 
     def soft_crossing() -> dict[str, Any]:
         xp = fem["soft_crossing"]["parameters"]
         return rod_soft_crossing(
             [s["w_over_d0"] * xp["diameter_m"] for s in fem["soft_crossing"]["steps"]],
             diameter=xp["diameter_m"], youngs_modulus=xp["youngs_modulus_pa"],
-            length_over_d0=xp["segment_length_m"] / xp["diameter_m"], contact=contact)
+            length_over_d0=xp["segment_length_m"] / xp["diameter_m"], contact=contact,
+            law=law)
 
     build = {"soft_wrap": soft_wrap, "clasp": clasp, "soft_crossing": soft_crossing}
     runs = {name: build[name]() for name in ROW_SCENES if name in scenes}
