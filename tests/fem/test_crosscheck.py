@@ -278,3 +278,30 @@ def test_each_compared_level_has_the_fem_spread_beside_it() -> None:
     plain = _compare(fem, rod, ("force", "force"), None)
     assert all(r["fem_spread_rel"] is None for r in plain["levels"])
     assert plain["fem_force_spread_max"] is None
+
+
+def test_a_finer_run_adds_the_third_mesh_beside_each_level() -> None:
+    """Given the next finer mesh's run (never run by the cross-check itself), each
+    compared level also reports the compared mesh's difference from it and the rod
+    model's force error against it; levels the finer run does not hold get neither, and
+    ``passed`` does not read them."""
+    from tightknot.fem.crosscheck import _compare
+
+    def step(force, approach, area, w):
+        return {"approach_over_d0": approach, "force": force, "area_ratio_mid": area,
+                "peak_pressure_over_e": 0.1, "w_over_d0": w}
+
+    fem = [step(1.0, 0.1, 0.99, 0.05), step(2.0, 0.2, 0.97, 0.1)]
+    rod = [dict(step(1.05, 0.1, 0.985, 0.05), converged=True),
+           dict(step(2.0, 0.2, 0.97, 0.1), converged=True)]
+    fine = [step(1.2, 0.1, 0.985, 0.05)]  # the first level only
+    out = _compare(fem, rod, ("force", "force"), None, finer_steps=fine)
+    first, second = out["levels"]
+    assert first["fem_spread_finer_rel"]["force"] == pytest.approx(1.0 / 1.2 - 1.0)
+    assert first["fem_spread_finer_rel"]["area_points"] == pytest.approx(0.005)
+    assert first["force_rel_finer"] == pytest.approx(1.05 / 1.2 - 1.0)
+    assert "force_rel_finer" not in second and "fem_spread_finer_rel" not in second
+    assert out["fem_force_spread_finer_max"] == pytest.approx(abs(1.0 / 1.2 - 1.0))
+    assert out["force_rel_finer_worst"] == pytest.approx(abs(1.05 / 1.2 - 1.0))
+    assert out["passed"] == _compare(fem, rod, ("force", "force"), None)["passed"]
+    assert "fem_force_spread_finer_max" not in _compare(fem, rod, ("force", "force"), None)

@@ -11,6 +11,8 @@ pytest.importorskip("felupe")
 from tightknot.fem.crosscheck import APPROACH_LIMIT, TARGETS  # noqa: E402
 from tightknot.fem.crosscheck_soft import (  # noqa: E402
     compare,
+    finer_mesh,
+    merge_fem_results,
     rod_runs,
     soft_rows,
     spread_mesh,
@@ -127,6 +129,46 @@ def _two_levels(result):
 def test_spread_mesh_is_the_next_coarser():
     assert spread_mesh("medium") == "coarse" and spread_mesh("fine") == "medium"
     assert spread_mesh("coarse") is None
+    assert finer_mesh("medium") == "fine" and finer_mesh("fine") is None
+
+
+def test_merge_fem_results_of_reports_and_scene_results():
+    # crosscheck --fem-json R F: a report's fem_results as it keys them, a scene result
+    # keyed by its mesh against the cross-check's, the first file holding a key wins
+    def scene(name, level, force):
+        return {"scene": name, "mesh": {"level": level}, "steps": [{"force": force}]}
+
+    report = {"fem_results": {"clasp": scene("clasp", "medium", 1.0),
+                              "clasp@coarse": scene("clasp", "coarse", 2.0)}}
+    merged = merge_fem_results([("R", report), ("F", scene("clasp", "fine", 3.0)),
+                                ("M", scene("clasp", "medium", 4.0)),
+                                ("S", scene("soft_wrap", "medium", 5.0))], "medium")
+    assert sorted(merged) == ["clasp", "clasp@coarse", "clasp@fine", "soft_wrap"]
+    assert merged["clasp"]["steps"][0]["force"] == 1.0  # the report came first
+    assert merged["clasp@fine"]["steps"][0]["force"] == 3.0
+    # on the fine mesh the fine run is the compared one, the medium one its spread
+    on_fine = merge_fem_results([("F", scene("clasp", "fine", 3.0)),
+                                 ("M", scene("clasp", "medium", 4.0))], "fine")
+    assert sorted(on_fine) == ["clasp", "clasp@medium"]
+    with pytest.raises(ValueError, match="--fem-json X: neither a crosscheck report"):
+        merge_fem_results([("X", {"rows": []})], "medium")
+    with pytest.raises(ValueError, match="--fem-json Y: its mesh level 'huge'"):
+        merge_fem_results([("Y", scene("clasp", "huge", 1.0))], "medium")
+
+
+def test_compare_with_the_finer_mesh():
+    # the soft rows take the finer run at the same load levels only (here the clasp's
+    # clamp travel); its columns are reported, not judged
+    fem = [_fem_step(2.0, 0.1, pull=0.5), _fem_step(3.0, 0.12, pull=0.6)]
+    rod = [_rod_step(2.1), _rod_step(3.3)]
+    fine = [_fem_step(2.5, 0.1, pull=0.5), _fem_step(9.0, 0.12, pull=0.65)]
+    out = compare("clasp", fem, rod, None, finer_steps=fine)
+    first, second = out["levels"]
+    assert first["fem_spread_finer_rel"]["force"] == pytest.approx(2.0 / 2.5 - 1.0)
+    assert first["force_rel_finer"] == pytest.approx(2.1 / 2.5 - 1.0)
+    assert "force_rel_finer" not in second  # 0.65 D0 is another level
+    assert out["force_rel_finer_worst"] == pytest.approx(abs(2.1 / 2.5 - 1.0))
+    assert out["passed"] == compare("clasp", fem, rod, None)["passed"]
 
 
 def test_soft_rows_from_one_coarse_level(soft_wrap_one_level, clasp_one_level,
@@ -184,3 +226,17 @@ def test_soft_rows_of_the_sectioned_level_with_the_bend_shift(
     assert abs(row["force_rel"]) <= 0.10 and abs(row["area_points"]) <= 0.05
     with pytest.raises(ValueError, match="levels"):
         soft_rows("coarse", fem, levels=("rigid",))
+
+
+def test_cli_fem_json_bad_files_exit_2(tmp_path, capsys):
+    from tightknot.app.cli import main
+
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({"rows": []}))
+    assert main(["fem", "crosscheck", "--fem-json", str(bad)]) == 2
+    assert f"--fem-json {bad}: not readable JSON" in capsys.readouterr().err
+    assert main(["fem", "crosscheck", "--fem-json", str(other)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"--fem-json {other}: neither a crosscheck report" in err[0]

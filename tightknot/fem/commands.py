@@ -97,9 +97,12 @@ def register(subparsers: Any) -> None:
                      help="crosscheck --contact sectioned: edges per D0 of the rod scenes "
                           "(default 12; the 0.012 D0 indent needs 24 or more, "
                           "docs/sectioned_level.md, 'Resolution')")
-    fem.add_argument("--fem-json", default=None, metavar="FILE",
-                     help="crosscheck only: reuse the FEM results of an earlier crosscheck "
-                          "report FILE (its fem_results) instead of running the FEM")
+    fem.add_argument("--fem-json", default=None, nargs="+", metavar="FILE",
+                     help="crosscheck only: reuse FEM results instead of running them: "
+                          "earlier crosscheck reports (their fem_results) or scene results "
+                          "(tightknot fem SCENE --json), the first file holding a scene "
+                          "and mesh winning; a scene on the next finer mesh is compared "
+                          "too (the FEM's third mesh, reported)")
     fem.set_defaults(handler=_run_fem)
 
     cal = subparsers.add_parser(
@@ -188,15 +191,19 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
         return _fail(problem)
     try:
         from .crosscheck import DEFAULT_MESH, crosscheck
+        from .crosscheck_soft import merge_fem_results
 
         fem_results = None
+        mesh = args.mesh or DEFAULT_MESH
         if args.fem_json is not None:
-            try:
-                fem_results = json.loads(Path(args.fem_json).read_text())["fem_results"]
-            except (OSError, ValueError, KeyError) as err:
-                return _fail(f"--fem-json {args.fem_json}: not a crosscheck report with "
-                             f"fem_results ({err})")
-        report = crosscheck(mesh=args.mesh or DEFAULT_MESH, fem_results=fem_results,
+            files = []
+            for name in args.fem_json:
+                try:
+                    files.append((name, json.loads(Path(name).read_text())))
+                except (OSError, ValueError) as err:
+                    return _fail(f"--fem-json {name}: not readable JSON ({err})")
+            fem_results = merge_fem_results(files, mesh)
+        report = crosscheck(mesh=mesh, fem_results=fem_results,
                             contact=args.contact, section_modes=args.section_modes,
                             soft=not args.no_soft, bend_shift=args.section_bend_shift,
                             thinning=args.section_thinning,

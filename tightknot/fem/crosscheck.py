@@ -63,7 +63,11 @@ The FEM's own spread (``fem_spread_rel`` of each compared level, ``fem_force_spr
 of each comparison): the same scene on the next coarser mesh (:func:`tightknot.fem.
 crosscheck_soft.spread_mesh`; none on the coarse mesh) at the same levels, its force's
 relative difference and its A/A0's in points: a rod-model error below it is within what
-the FEM itself can tell. Reported beside the targets, not part of ``passed``.
+the FEM itself can tell. Where a run on the next finer mesh is given (``fem_results`` key
+"indent@fine" ..., never run here), each level also carries the compared mesh's
+difference from it and the rod model's force error against it
+(:func:`~tightknot.fem.crosscheck_soft.finer_columns`). Reported beside the targets, not
+part of ``passed``.
 
 Wall time. ``fem_over_rod_time_ratio`` is the FEM wall time of the compared runs (one mesh
 each, all load levels) over the rod model's (all levels, model set-up included, after
@@ -76,7 +80,15 @@ import math
 import time
 from typing import Any
 
-from .crosscheck_soft import fem_runs, fem_spread, spread_mesh
+from .crosscheck_soft import (
+    aligned_steps,
+    fem_runs,
+    fem_spread,
+    finer_columns,
+    finer_mesh,
+    finer_summary,
+    spread_mesh,
+)
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .material import ROD_DIAMETER
 from .rod_model import EDGES_PER_D0, check_edges_per_d0, rod_indent, rod_wrap
@@ -106,8 +118,8 @@ def fem_width_fraction(step: dict[str, Any], scene: str) -> float | None:
 
 def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str, str],
              kappa_key: str | None, width_scene: str | None = None,
-             limit: float = APPROACH_LIMIT, spread_steps: list[dict] | None = None
-             ) -> dict[str, Any]:
+             limit: float = APPROACH_LIMIT, spread_steps: list[dict] | None = None,
+             finer_steps: list[dict] | None = None) -> dict[str, Any]:
     """Per-level comparison up to an approach of ``limit`` D0 (gated on the FEM's
     ``approach_over_d0``; default ``APPROACH_LIMIT``, the targets' range).
     ``force_keys``: (FEM key, rod key) of the compared force; ``kappa_key``: the FEM
@@ -117,12 +129,15 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
     (:func:`fem_width_fraction` of that scene), None: not compared; ``spread_steps``: the
     same scene on the next coarser mesh at the same levels, whose difference from
     ``fem_steps`` each row reports as the FEM's own spread (``fem_spread_rel``:
-    :func:`~tightknot.fem.crosscheck_soft.fem_spread`; None without)."""
+    :func:`~tightknot.fem.crosscheck_soft.fem_spread`; None without); ``finer_steps``:
+    the scene on the next finer mesh, where given
+    (:func:`~tightknot.fem.crosscheck_soft.finer_columns`)."""
     fem_force, rod_force = force_keys
     rows = []
     spread = list(spread_steps or [])
     spread += [None] * (len(fem_steps) - len(spread))
-    for f, r, c in zip(fem_steps, rod_steps, spread, strict=True):
+    finer = aligned_steps(fem_steps, finer_steps)
+    for f, r, c, g in zip(fem_steps, rod_steps, spread, finer, strict=True):
         if f["approach_over_d0"] > limit + 1e-9:
             continue
         if c is not None and any(k in f and k in c and not math.isclose(f[k], c[k])
@@ -144,6 +159,9 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
         if kappa_key is not None:
             row.update(fem_kappa_d0=f[kappa_key], rod_kappa_d0=r["kappa_d0_mid"],
                        curvature_rel=relative(r["kappa_d0_mid"], f[kappa_key]))
+        if g is not None:
+            row.update(finer_columns(f, r, g, fem_force, rod_force, "area_ratio_mid",
+                                     kappa_key))
         row["met"] = {
             "force": abs(row["force_rel"]) <= TARGETS["force_rel"],
             "area": abs(row["area_points"]) <= TARGETS["area_points"],
@@ -166,6 +184,7 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
     spreads = [abs(x["fem_spread_rel"]["force"]) for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
             "fem_force_spread_max": max(spreads, default=None),
+            **finer_summary(rows),
             "passed": bool(rows) and all(all(x["met"].values()) for x in rows)}
 
 
@@ -317,7 +336,8 @@ def _wrap_variants(fem_wrap: dict[str, Any]) -> dict[str, Any]:
 
 def _smoothed_level(fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
                     rod_ind: dict[str, Any], rod_wr: dict[str, Any],
-                    spread: dict[str, list[dict] | None]) -> dict[str, Any]:
+                    spread: dict[str, list[dict] | None],
+                    finer: dict[str, list[dict] | None]) -> dict[str, Any]:
     """Both scenes with the "smoothed" contact level (the section thinned by the stretch
     averaged over +-1 D0 along the rod, :mod:`tightknot.contact.section_radius`): the same
     comparisons and targets as the default level's, reported beside them (``passed`` of
@@ -328,10 +348,11 @@ def _smoothed_level(fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
     wr = _rod_wrap_like(fem_wrap, radius_window=window)
     comp = {
         "indent": _compare(fem_ind["steps"], ind["steps"], ("force", "force"), None,
-                           spread_steps=spread["indent"]),
+                           spread_steps=spread["indent"], finer_steps=finer["indent"]),
         "wrap": _compare(fem_wrap["steps"], wr["steps"],
                          ("force_per_length_mid_nominal", "force_per_length_mid"),
-                         "kappa_d0_mid_nominal", spread_steps=spread["wrap"]),
+                         "kappa_d0_mid_nominal", spread_steps=spread["wrap"],
+                         finer_steps=finer["wrap"]),
     }
     axial = [{"approach_over_d0": f["approach_over_d0"],
               "fem_axial_force_mid_over_e_d0sq": f.get("axial_force_mid_over_e_d0sq"),
@@ -379,8 +400,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     sectioned level in a sectioned one; that level's ``passed`` part of the report's).
 
     ``fem_results`` may hold already computed FEM results (keys "indent", "wrap",
-    "soft_wrap", "clasp", "soft_crossing" and the soft scenes on the spread mesh,
-    "soft_wrap@coarse" ...,
+    "soft_wrap", "clasp", "soft_crossing", each scene on the spread mesh,
+    "soft_wrap@coarse" ..., and optionally on the next finer mesh, "soft_wrap@fine" ...,
     run with the default load levels, as a report's ``fem_results`` keeps them) to reuse;
     their own ``wall_time_s`` then enters the ratio. Returns the JSON-serialisable report
     (module docstring): per-scene comparisons, ``fem_over_rod_time_ratio``, ``passed``.
@@ -407,9 +428,14 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     coarser = spread_mesh(mesh)
     spread = {name: None if coarser is None else fem_results[f"{name}@{coarser}"]["steps"]
               for name in ("indent", "wrap")}
+    # the next finer mesh where a run of it was given: the third mesh of the spread
+    finest = finer_mesh(mesh)
+    finer = {name: (fem_results[f"{name}@{finest}"]["steps"]
+                    if f"{name}@{finest}" in fem_results else None)
+             for name in ("indent", "wrap")}
     if contact == "sectioned":
         report = _sectioned_report(mesh, fem_ind, fem_wrap, section_modes, start, bend_shift,
-                                   thinning, rod_edges_per_d0, spread)
+                                   thinning, rod_edges_per_d0, spread, finer)
         report["fem_results"].update({k: v for k, v in fem_results.items()
                                       if k.startswith(("indent@", "wrap@"))})
         if soft:
@@ -434,7 +460,7 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     diagnostics = _indent_diagnostics(fem_ind, rod_ind)
     diagnostics["indent_footprint"] = _indent_footprint(fem_ind, rod_ind)
     diagnostics["wrap_kernel_variants"] = _wrap_variants(fem_wrap)
-    smoothed = _smoothed_level(fem_ind, fem_wrap, rod_ind, rod_wr, spread)
+    smoothed = _smoothed_level(fem_ind, fem_wrap, rod_ind, rod_wr, spread, finer)
     fem_time = fem_ind["wall_time_s"] + fem_wrap["wall_time_s"]
     rod_time = rod_ind["wall_time_s"] + rod_wr["wall_time_s"]
     scenes = {
@@ -444,7 +470,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
             "fem_mesh": fem_ind["mesh"], "fem_wall_time_s": fem_ind["wall_time_s"],
             "rod_wall_time_s": rod_ind["wall_time_s"], "rod_vertices": rod_ind["vertices"],
             "comparison": _compare(fem_ind["steps"], rod_ind["steps"], ("force", "force"),
-                                   None, spread_steps=spread["indent"]),
+                                   None, spread_steps=spread["indent"],
+                                   finer_steps=finer["indent"]),
             "fem_steps": fem_ind["steps"], "rod_steps": rod_ind["steps"],
         },
         "wrap": {
@@ -454,7 +481,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
             "wrap_angle_deg": wp_["wrap_angle_deg"],
             "comparison": _compare(fem_wrap["steps"], rod_wr["steps"],
                                    ("force_per_length_mid_nominal", "force_per_length_mid"),
-                                   "kappa_d0_mid_nominal", spread_steps=spread["wrap"]),
+                                   "kappa_d0_mid_nominal", spread_steps=spread["wrap"],
+                                   finer_steps=finer["wrap"]),
             "centroid_axis": _wrap_centroid_axis(fem_wrap["steps"], rod_wr["steps"]),
             "total_force_statics": [
                 {"tension_over_e_d0sq": f["tension_over_e_d0sq"],
@@ -501,7 +529,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
 def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, Any],
                       section_modes: int, start: float, bend_shift: bool = False,
                       thinning: str = "edge", edges_per_d0: int = EDGES_PER_D0,
-                      spread: dict[str, list[dict] | None] | None = None
+                      spread: dict[str, list[dict] | None] | None = None,
+                      finer: dict[str, list[dict] | None] | None = None
                       ) -> dict[str, Any]:
     """The cross-check of the sectioned level (:mod:`tightknot.fem.rod_sectioned`): force,
     A/A0, L_c and (wrap) curvature at every level, against the targets."""
@@ -526,7 +555,8 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
             "rod_wall_time_s": rod_ind["wall_time_s"], "rod_vertices": rod_ind["vertices"],
             "comparison": _compare(fem_ind["steps"], rod_ind["steps"], ("force", "force"),
                                    None, width_scene="indent",
-                                   spread_steps=(spread or {}).get("indent")),
+                                   spread_steps=(spread or {}).get("indent"),
+                                   finer_steps=(finer or {}).get("indent")),
             "fem_steps": fem_ind["steps"], "rod_steps": rod_ind["steps"],
         },
         "wrap": {
@@ -536,7 +566,8 @@ def _sectioned_report(mesh: str, fem_ind: dict[str, Any], fem_wrap: dict[str, An
             "comparison": _compare(fem_wrap["steps"], rod_wr["steps"],
                                    ("force_per_length_mid_nominal", "force_per_length_mid"),
                                    "kappa_d0_mid_nominal", width_scene="wrap",
-                                   spread_steps=(spread or {}).get("wrap")),
+                                   spread_steps=(spread or {}).get("wrap"),
+                                   finer_steps=(finer or {}).get("wrap")),
             "centroid_axis": [
                 {"tension_over_e_d0sq": f["tension_over_e_d0sq"],
                  "fem_kappa_d0_centroid": f["kappa_d0_mid"],

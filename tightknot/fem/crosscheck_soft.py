@@ -33,7 +33,11 @@ Mesh spread (``fem_spread_rel``, per compared level): the relative difference of
 compared FEM quantity between the comparison's mesh and the next coarser one (medium:
 coarse; fine: medium) at the same load level. On the coarse mesh there is none
 (``spread_mesh`` None). A rod-model error smaller than the spread is within what the FEM
-itself can tell.
+itself can tell. Where the next finer mesh's run is given too (never run here: the fine
+meshes take tens of minutes; ``tightknot fem crosscheck --fem-json REPORT FINE``), each
+compared level also reports the compared mesh's difference from it
+(``fem_spread_finer_rel``) and the rod model's force error against it
+(``force_rel_finer``): the third mesh of the FEM's spread, reported, not judged.
 
 The clasp's kinematic diagnostic. Both models clamp their U's at the same points, but the
 U's settle differently before they touch: a tightly bent solid moves its section toward
@@ -48,6 +52,7 @@ offset comes from the FEM.
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
@@ -79,6 +84,47 @@ def spread_mesh(mesh: str) -> str | None:
     (None for the coarsest)."""
     k = MESH_LEVELS.index(mesh)
     return MESH_LEVELS[k - 1] if k > 0 else None
+
+
+def finer_mesh(mesh: str) -> str | None:
+    """The next finer mesh than ``mesh`` (None for the finest): its run, where one is
+    given (never run by the cross-check: the fine meshes take tens of minutes), shows how
+    far ``mesh`` itself is from converged."""
+    k = MESH_LEVELS.index(mesh)
+    return MESH_LEVELS[k + 1] if k + 1 < len(MESH_LEVELS) else None
+
+
+def same_levels(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Whether two steps of a scene on different meshes are at one load level (the
+    scenes' load keys: approach, tension, clamp travel)."""
+    keys = [k for k in ("w_over_d0", "tension", "tension_over_e_d0sq", "pull_over_d0")
+            if k in a and k in b]
+    return all(math.isclose(a[k], b[k], rel_tol=1e-9, abs_tol=1e-15) for k in keys)
+
+
+def merge_fem_results(files: list[tuple[str, dict[str, Any]]], mesh: str
+                      ) -> dict[str, dict]:
+    """The FEM results of several files for a cross-check on ``mesh``: each (name, data)
+    is a cross-check report (its ``fem_results``, keys as it holds them) or one scene's
+    result (``tightknot fem SCENE --json``: key SCENE on ``mesh``, SCENE@LEVEL on another
+    mesh). The first file holding a key wins. ValueError naming the file that is
+    neither."""
+    out: dict[str, dict] = {}
+    for name, data in files:
+        if isinstance(data, dict) and isinstance(data.get("fem_results"), dict):
+            found = data["fem_results"]
+        elif isinstance(data, dict) and "scene" in data and "steps" in data:
+            level = data.get("mesh", {}).get("level")
+            if level not in MESH_LEVELS:
+                raise ValueError(f"--fem-json {name}: its mesh level {level!r} is none of "
+                                 f"{MESH_LEVELS}")
+            found = {data["scene"] if level == mesh else f"{data['scene']}@{level}": data}
+        else:
+            raise ValueError(f"--fem-json {name}: neither a crosscheck report with "
+                             f"fem_results nor a FEM scene result")
+        for key, value in found.items():
+            out.setdefault(key, value)
+    return out
 
 
 def fem_runs(mesh: str, fem_results: dict[str, dict] | None = None,
@@ -195,16 +241,19 @@ _AREA_B_KEYS: dict[str, str] = {"soft_wrap": "area_ratio_mid_b",
 
 
 def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
-            spread_steps: list[dict] | None, matched_steps: list[dict] | None = None
-            ) -> dict[str, Any]:
+            spread_steps: list[dict] | None, matched_steps: list[dict] | None = None,
+            finer_steps: list[dict] | None = None) -> dict[str, Any]:
     """Per-level comparison of one soft scene (module docstring): force, area, curvature,
     pressure, each FEM value's mesh spread, and the targets met; with ``matched_steps``
-    (the clasp's rod model with the kinematics matched) also that diagnostic's force."""
+    (the clasp's rod model with the kinematics matched) also that diagnostic's force; with
+    ``finer_steps`` (the scene on the next finer mesh) :func:`finer_columns`."""
     f_key, r_key, fa_key, ra_key, fk_key, rk_key, kappa_target = _KEYS[scene]
     rows = []
     spread_steps = spread_steps or [None] * len(fem_steps)
     matched = matched_steps or [None] * len(fem_steps)
-    for f, r, c, m in zip(fem_steps, rod_steps, spread_steps, matched, strict=True):
+    finer = aligned_steps(fem_steps, finer_steps)
+    for f, r, c, m, g in zip(fem_steps, rod_steps, spread_steps, matched, finer,
+                             strict=True):
         # no contact yet (the clasp's bends apart): the FEM's force is round-off there
         if f["approach_over_d0"] > APPROACH_LIMIT + 1e-9 or f["peak_pressure_over_e"] <= 0.0:
             continue
@@ -228,6 +277,8 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
         if b_key is not None:
             row.update({"fem_area_ratio_b": f[b_key], "rod_area_ratio_b": r[b_key],
                         "area_points_b": r[b_key] - f[b_key]})
+        if g is not None:
+            row.update(finer_columns(f, r, g, f_key, r_key, fa_key, fk_key))
         if m is not None:
             row["rod_force_kinematics_matched"] = m[r_key]
             row["force_rel_kinematics_matched"] = relative(m[r_key], f[f_key])
@@ -245,7 +296,37 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
     spreads = [x["fem_spread_rel"]["force"] for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
             "fem_force_spread_max": max((abs(s) for s in spreads), default=None),
+            **finer_summary(rows),
             "passed": bool(rows) and all(all(x["met"].values()) for x in rows)}
+
+
+def aligned_steps(fem_steps: list[dict], other: list[dict] | None) -> list[dict | None]:
+    """``other``'s step at each of ``fem_steps``' load levels (None where it has none)."""
+    out: list[dict | None] = []
+    for f in fem_steps:
+        out.append(next((g for g in other or [] if same_levels(f, g)), None))
+    return out
+
+
+def finer_columns(fem: dict[str, Any], rod: dict[str, Any], finer: dict[str, Any],
+                  force_key: str, rod_force_key: str, area_key: str,
+                  kappa_key: str | None) -> dict[str, Any]:
+    """A compared level's columns against the next finer mesh (reported, not part of
+    ``passed``): the compared mesh's own difference from it (``fem_spread_finer_rel``, as
+    :func:`fem_spread`) and the rod model's force error against it (``force_rel_finer``)."""
+    return {"fem_spread_finer_rel": fem_spread(fem, finer, force_key, area_key, kappa_key),
+            "force_rel_finer": relative(rod[rod_force_key], finer[force_key])}
+
+
+def finer_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """A comparison's largest finer-mesh spread and rod error (empty without a finer run)."""
+    spreads = [abs(x["fem_spread_finer_rel"]["force"]) for x in rows
+               if "fem_spread_finer_rel" in x]
+    if not spreads:
+        return {}
+    return {"fem_force_spread_finer_max": max(spreads),
+            "force_rel_finer_worst": max(abs(x["force_rel_finer"]) for x in rows
+                                         if "force_rel_finer" in x)}
 
 
 def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
@@ -257,6 +338,7 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
     model at least 1000 times faster than the FEM on each scene)."""
     fem = fem_runs(mesh, fem_results)
     spread = spread_mesh(mesh)
+    finer = finer_mesh(mesh)
     names = tuple(CONTACT_LEVELS if levels is None else levels)
     from .rod_model_soft import CONTACT_LEVELS as ROD_LEVELS
 
@@ -270,11 +352,13 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
         scenes = {}
         for name in ROW_SCENES:
             ref = fem.get(f"{name}@{spread}") if spread else None
+            fine = fem.get(f"{name}@{finer}") if finer else None
             matched = rod.get(f"{name}_matched")
             scenes[name] = {
                 "comparison": compare(name, fem[name]["steps"], rod[name]["steps"],
                                       ref["steps"] if ref else None,
-                                      matched["steps"] if matched else None),
+                                      matched["steps"] if matched else None,
+                                      fine["steps"] if fine else None),
                 "fem_wall_time_s": fem[name]["wall_time_s"],
                 "rod_wall_time_s": rod[name]["wall_time_s"],
                 "fem_over_rod_time_ratio": fem[name]["wall_time_s"] / rod[name]["wall_time_s"],
@@ -294,6 +378,7 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
                 "level, with the FEM's mesh spread (tightknot/fem/crosscheck_soft.py)",
         "mesh": mesh,
         "spread_mesh": spread,
+        "finer_mesh": finer if any(f"{n}@{finer}" in fem for n in ROW_SCENES) else None,
         "fem": {name: {"mesh": fem[name]["mesh"], "wall_time_s": fem[name]["wall_time_s"],
                        "steps": fem[name]["steps"],
                        "spread_steps": (fem[f"{name}@{spread}"]["steps"] if spread else None)}
