@@ -589,10 +589,8 @@ def _tie(scene: KnotScene, pull_force: float | None, end_distance: float | None,
             final_force = f0 * (pull_force / f0) ** res.t
         way = " (at the compliant level: the sections join the loosened knot)" if late else ""
         return fail(f"pull: {res.failure}{way}", system, final_force, res.failed_state)
-    if late:
-        route = "final"
     out = TieResult(True, "", phases, iters, time.perf_counter() - start, types, final_force,
-                    system, section_path=route)
+                    system, section_path="final" if late else route)
     if late:
         out = yield from section_finish(sections, out, residual_tol, hook, knot_type,
                                         end_distance is not None)
