@@ -108,3 +108,40 @@ def test_soft_crossing_point_law_recovers_a_power_law_and_replaces_only_the_poin
                        "p_pmax_point", "source"}
     with pytest.raises(ValueError, match="two or more load steps"):
         soft_crossing_point_law({"steps": steps[:1]})
+
+
+def test_crossing_law_bench_bad_input_exits_2(tmp_path, capsys):
+    # bench/crossing_law.py: a report without the soft scenes, or a --fit file that is not
+    # a soft crossing, is one line on stderr and exit 2, nothing written
+    import sys
+    from pathlib import Path
+
+    bench = Path(__file__).resolve().parents[2] / "bench"
+    sys.path.insert(0, str(bench))
+    try:
+        import crossing_law
+    finally:
+        sys.path.remove(str(bench))
+    report = tmp_path / "r.json"
+    report.write_text(json.dumps({"fem_results": {"indent": {"scene": "indent"}}}))
+    out = tmp_path / "out.json"
+    assert crossing_law.main(["--fem-json", str(report), "--out", str(out)]) == 2
+    assert "--fit: not a soft_crossing scene result" in capsys.readouterr().err
+    wrong = tmp_path / "w.json"
+    wrong.write_text(json.dumps({"scene": "indent", "steps": []}))
+    assert crossing_law.main(["--fem-json", str(report), "--fit", str(wrong)]) == 2
+    assert "--fit: not a soft_crossing" in capsys.readouterr().err
+    fit = tmp_path / "x.json"
+    fit.write_text(json.dumps({"scene": "soft_crossing", "mesh": {"level": "coarse"},
+                               "steps": [{"w_over_d0": 0.01, "force_over_e_d0sq": 1e-3,
+                                          "semi_axis_axial_over_d0": 0.1,
+                                          "peak_pressure_over_e": 0.1},
+                                         {"w_over_d0": 0.04, "force_over_e_d0sq": 1e-2,
+                                          "semi_axis_axial_over_d0": 0.2,
+                                          "peak_pressure_over_e": 0.2}]}))
+    assert crossing_law.main(["--fem-json", str(report), "--fit", str(fit),
+                              "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "holds no FEM result of ['soft_wrap', 'clasp', 'soft_crossing']" \
+        in err[0]
+    assert not out.exists()
