@@ -686,3 +686,35 @@ def test_the_penalty_scale_scales_the_contact_and_nothing_else() -> None:
     for bad in (0.0, 1.5, float("nan")):
         with pytest.raises(ValueError, match="penalty scale"):
             layer.set_penalty_scale(bad)
+
+
+@pytest.mark.parametrize("step", [0.0, 0.3])
+def test_the_reported_traction_is_the_one_the_energy_applies(step: float) -> None:
+    # Rod A crosses rod B over a vertex where B's edges are stretched unevenly (1 - step,
+    # 1 + step alternately), so that B's mean radius steps there (by 0.10 D0 at step
+    # 0.3). The report's contact force on A, its edges' force per length times their rest
+    # lengths, is the force the energy applies to A: each sample's traction is its
+    # partner passes' penalty slopes weighed as the energy weighs them. Tolerance: the two
+    # half-weight passes see the partner's surface differently (A's report -2.9 % at
+    # step 0.3, +1.1 % without a step); the largest pass alone reports a neighbour edge's
+    # thicker surface, extended with a small weight, and about twice the force at step 0.3.
+    mat = Material(1.25e6, 0.5, 1160.0)
+    b = RodBuilder(twist=False)
+    z = np.linspace(-1.5 * D0, 1.5 * D0, 25)
+    b.add_rod(np.c_[np.zeros(25), np.zeros(25), z], D0, mat)
+    s = np.cumsum(np.r_[0.0, (z[1] - z[0]) * (1.0 + step * (-1.0) ** np.arange(24))])
+    b.add_rod(np.c_[z, np.full(25, 0.97 * D0), np.zeros(25)], D0, mat)
+    model = b.finalize()
+    state = State.initial(model)
+    state.x[25:, 0] = s - s[12]  # B's middle vertex under A
+    system = RodSystem(model, state, BoundaryConditions(model))
+    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=64))
+    system.add_term(layer)
+    x, rest, frames = system.state.x, system.rest, system.state.frames
+    extra = np.zeros(layer.dof_count)
+    _, g_x, _, _ = layer.contact_energy(x, extra, frames, rest, True, False)
+    force = float(np.linalg.norm(g_x[:25].sum(axis=0)))
+    per_edge = layer.section_report(x, extra, frames, rest)["force_per_length_edges"]
+    reported = float(per_edge[:24] @ rest[:24])
+    assert force > 0.0
+    assert reported == pytest.approx(force, rel=0.05)

@@ -996,11 +996,14 @@ class SectionedLayer(ContactLayer):
         * ``contact_width_fraction``: L_c, the part of the deformed boundary's length whose
           samples penetrate a partner (any), over the boundary's length, at the vertex's
           edges' Gauss circles (the larger of the vertex's edges);
-        * ``peak_pressure_over_E``, ``mean_pressure_over_E``: the penalty's pressure
-          kappa pen over E at those samples, largest and mean (one sample's largest
-          penalty: an upper estimate of the solid's peak, docs/fem_crosscheck.md);
+        * ``peak_pressure_over_E``, ``mean_pressure_over_E``: the traction the energy
+          applies at those samples over E, largest and mean: the penalty's slope
+          phi'(pen) in each partner edge's pass, weighed by the pass's partition and
+          exclusion weights as the energy weighs it, summed over the passes (a sample's
+          value, not a patch's mean: docs/fem_crosscheck.md);
         * ``force_per_length``: the contact force per unit rest length [N/m] (sum of the
-          samples' kappa pen times their rest area, over the edge);
+          samples' tractions times their rest area, over the edge; per edge too,
+          ``force_per_length_edges``);
         * ``half_width``: L_c pi D0 / 4 [m], the half-width of each of two opposite
           contacts sharing the width;
         * ``area_ratio``: A/A0 = lambda^(-2 nu), lambda the stretch of the vertex's edges
@@ -1016,14 +1019,28 @@ class SectionedLayer(ContactLayer):
         x = self.boundary_centres(x, rest)  # the boundaries' centres and mean stretch
         wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
         data = self._state_arrays(extra, *frames, rest, arcs, rod_len, x)
-        pen = np.zeros((n_e, ng, ms))
+        emod = self.edge_modulus
+        press = np.zeros((n_e, ng, ms))
         if pairs.shape[0]:
             out = self._launch(sk.REPORT, wx, pairs, data, report=True)
             host = pairs.numpy().astype(np.int64)
             owner = np.stack([host[:, 0], host[:, 1]], axis=1).reshape(-1)  # pass -> its A
-            p = np.where(out["weight"] > 0.0, out["pen"], 0.0)
-            touch = np.flatnonzero((p > 0.0).any(axis=(1, 2)))  # the passes in contact
-            np.maximum.at(pen, owner[touch], p[touch])
+            # The traction the energy applies at a sample: the penalty's slope in each
+            # partner edge's pass, weighed as the energy weighs it (the partition of unity
+            # over the partner's edges, the exclusion ramp), summed over the passes. The
+            # largest pass alone would report a neighbour edge's surface, extended with a
+            # small weight, wherever the partner's radius steps at a vertex.
+            e_a, e_b = host[:, 0], host[:, 1]
+            e_pair = 2.0 * emod[e_a] * emod[e_b] / (emod[e_a] + emod[e_b])
+            d_pair = self.edge_r0[e_a] + self.edge_r0[e_b]
+            kappa = np.repeat(self.penalty * e_pair / d_pair, 2)[:, None, None]
+            onset = np.repeat(self.section.onset * d_pair, 2)[:, None, None]
+            g = np.maximum(out["pen"], 0.0)
+            slope = np.where(g < onset, kappa * g * g / (2.0 * onset),
+                             kappa * (g - 0.5 * onset))
+            t = np.maximum(out["weight"], 0.0) * slope
+            touch = np.flatnonzero((t > 0.0).any(axis=(1, 2)))  # the passes in contact
+            np.add.at(press, owner[touch], t[touch])
         # the deformed boundary's length element r ds at each sample, per Gauss circle
         c0, c1 = self.edge_sections(extra, frames[2])
         phis = 2.0 * math.pi * (np.arange(ms) + 0.5) / ms
@@ -1036,7 +1053,7 @@ class SectionedLayer(ContactLayer):
         lam = (length / rest if self.rod_mean is None
                else self.rod_mean.stretch(x, rest))
         big_r0 = self.edge_r0 * lam ** (-self.edge_nu)
-        in_contact = pen > 0.0
+        in_contact = press > 0.0
         width = np.zeros((n_e, ng))
         for gi, u in enumerate(self.settings.gauss[0]):
             c = (1.0 - u) * c0 + u * c1
@@ -1045,9 +1062,7 @@ class SectionedLayer(ContactLayer):
             dr = c @ slope.T
             ds = np.sqrt(r * r + dr * dr)
             width[:, gi] = np.sum(ds * in_contact[:, gi], axis=1) / np.sum(ds, axis=1)
-        emod = self.edge_modulus
         d0 = 2.0 * self.edge_r0
-        press = self.penalty * emod[:, None, None] / d0[:, None, None] * pen
         has = in_contact.any(axis=2)
         mean_p = np.where(has, press.sum(axis=2) / np.maximum(in_contact.sum(axis=2), 1), 0.0)
         g_w = np.asarray(self.settings.gauss[1])
@@ -1064,6 +1079,7 @@ class SectionedLayer(ContactLayer):
                 "peak_pressure_over_E": to_vertex(press.max(axis=(1, 2)) / emod),
                 "mean_pressure_over_E": to_vertex(mean_p.max(axis=1) / emod),
                 "force_per_length": to_vertex(f_len),
+                "force_per_length_edges": f_len,
                 "half_width": 0.25 * math.pi * to_vertex(d0) * lc,
                 "area_ratio": stretch_v ** (-2.0 * nu_v)}
 
