@@ -1033,12 +1033,13 @@ class SectionedLayer(ContactLayer):
             e_a, e_b = host[:, 0], host[:, 1]
             e_pair = 2.0 * emod[e_a] * emod[e_b] / (emod[e_a] + emod[e_b])
             d_pair = self.edge_r0[e_a] + self.edge_r0[e_b]
-            kappa = np.repeat(self.penalty * e_pair / d_pair, 2)[:, None, None]
+            penalty = self.penalty * self.penalty_scale  # the kernels' (the homotopy's)
+            kappa = np.repeat(penalty * e_pair / d_pair, 2)[:, None, None]
             onset = np.repeat(self.section.onset * d_pair, 2)[:, None, None]
             g = np.maximum(out["pen"], 0.0)
-            slope = np.where(g < onset, kappa * g * g / (2.0 * onset),
-                             kappa * (g - 0.5 * onset))
-            t = np.maximum(out["weight"], 0.0) * slope
+            dphi = np.where(g < onset, kappa * g * g / (2.0 * onset),
+                            kappa * (g - 0.5 * onset))
+            t = np.maximum(out["weight"], 0.0) * dphi
             touch = np.flatnonzero((t > 0.0).any(axis=(1, 2)))  # the passes in contact
             np.add.at(press, owner[touch], t[touch])
         # the deformed boundary's length element r ds at each sample, per Gauss circle
