@@ -61,6 +61,24 @@ def test_soft_wrap_statics_and_shared_overlap(soft_wrap_rod):
     assert soft["steps"][1]["area_ratio_mid_b"] < soft["steps"][0]["area_ratio_mid_b"]
 
 
+def test_soft_wrap_reads_the_nominal_axis_as_the_fem_does(soft_wrap_rod):
+    # The FEM's nominal axis is its far fibre moved in by the stretched radius. A compliant
+    # section keeps its far side at that radius, so its centreline is that axis; a
+    # sectioned level's far side moves with its modes, so its curvature is read on its far
+    # fibre (as the rigid wrap's, rod_sectioned), the centreline's reported beside it.
+    # Measured at the medium FEM's lightest two tensions: far fibre 0.13 and 0.65 of the
+    # centreline's curvature, so a reading of the centreline fails the bound below.
+    from tightknot.fem.rod_model_soft import rod_soft_wrap
+
+    tensions, compliant = soft_wrap_rod
+    for s in compliant["steps"]:
+        assert s["kappa_d0_mid"] == s["kappa_d0_mid_centerline"] > 0.0
+    sectioned = rod_soft_wrap(tensions, contact="sectioned")
+    for s in sectioned["steps"]:
+        assert s["converged"]
+        assert 0.0 < s["kappa_d0_mid"] < 0.9 * s["kappa_d0_mid_centerline"]
+
+
 def test_clasp_rod_model_is_clamped_where_the_fem_clamps():
     # the FEM scene starts its Rivlin-bent sections with their inner fibres a gap g0
     # apart, so its centrelines start 2 b' + g0 apart, not D0; the rod model's U's must

@@ -33,6 +33,7 @@ from .rod_model import (
     _solve_levels,
     wrap_scene,
 )
+from .rod_sectioned import far_fibre_axis
 
 CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed", "sectioned")
 """Contact levels of the rod model here (:func:`contact_term`)."""
@@ -120,8 +121,11 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     along it), with the soft pair law.
 
     Returns per level the keys of :func:`tightknot.fem.rod_model.rod_wrap` (the mid line
-    load per length of the centreline, curvature, approach, overlap, A/A0, peak pressure)
-    and ``area_ratio_mid_b``, ``profile_a``, ``profile_b``; and the wall time.
+    load per length of the nominal axis, its curvature and approach, overlap, A/A0, peak
+    pressure; the nominal axis is the centreline, or at the sectioned level the far fibre
+    moved in by the stretched radius, as the FEM's), ``kappa_d0_mid_centerline`` (the
+    centreline's curvature), ``area_ratio_mid_b``, ``profile_a``, ``profile_b``; and the
+    wall time.
     """
     from tightknot.knots.curvature import bergou_curvature
 
@@ -141,14 +145,28 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     s_b = np.linspace(-2 * d0, 2 * d0, n_obs + 1)
 
     def measure(tension: float) -> dict[str, Any]:
-        # the axis the FEM's nominal one stands for: the sections' centres
         x = _centres(term, system)
         g = system.term_gradient(term)
         xr = x[rod_v]
         e = np.linalg.norm(np.diff(xr, axis=0), axis=1)
         voronoi = 0.5 * (e[mid - 1] + e[mid])
-        f_mid = float(np.linalg.norm(g[rod_v[mid]]) / voronoi)
-        xm = xr[mid]
+        # The axis the FEM's nominal one (its far fibre moved in by the stretched radius)
+        # stands for: the centreline, whose far side a compliant or smoothed section keeps
+        # at that radius; a sectioned level's far side moves with its modes, so it is read
+        # on its far fibre as the rigid wrap's is (rod_sectioned.rod_wrap_sectioned).
+        kappa_c = float(bergou_curvature(xr, closed=False)[mid])
+        if hasattr(term, "boundary_centres"):
+            r_str = 0.5 * d0 / math.sqrt(voronoi / (2.0 * half / n_rod))
+            near = rod_v[mid - 3:mid + 4]
+            nominal = far_fibre_axis(term, system, near, y_obs, r_str)
+            seg = np.linalg.norm(np.diff(nominal, axis=0), axis=1)
+            f_mid = float(np.linalg.norm(g[rod_v[mid]]) / (0.5 * (seg[2] + seg[3])))
+            kappa = float(bergou_curvature(nominal, closed=False)[3])
+            xm = nominal[3]
+        else:
+            f_mid = float(np.linalg.norm(g[rod_v[mid]]) / voronoi)
+            kappa = kappa_c
+            xm = xr[mid]
         dist = math.hypot(y_obs - xm[1], xm[2])
         rep = _report(term, system)
         prof_a = _profile(rep, rod_v, s_a, d0)
@@ -163,7 +181,8 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
             "contact_force_total": float(np.linalg.norm(g[rod_v].sum(axis=0))),
             "force_per_length_mid": f_mid,
             "force_per_length_mid_over_e_d0": f_mid / (youngs_modulus * d0),
-            "kappa_d0_mid": float(bergou_curvature(xr, closed=False)[mid]) * d0,
+            "kappa_d0_mid": kappa * d0,
+            "kappa_d0_mid_centerline": kappa_c * d0,
             "area_ratio_mid": prof_a[mid]["area_ratio"],
             "area_ratio_mid_b": prof_b[n_obs // 2]["area_ratio"],
             "peak_pressure_over_e": prof_a[mid]["peak_pressure_over_e"],

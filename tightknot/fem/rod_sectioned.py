@@ -100,8 +100,8 @@ def _vertex_section(layer: Any, system: Any, v: int
     return t, d1, np.cross(t, d1), c, math.sqrt(layer.edge_r0[e] ** 2 / lam - 0.5 * float(c @ c))
 
 
-def _far_fibre_axis(layer: Any, system: Any, verts: np.ndarray, axis_y: float,
-                    r_stretched: float) -> np.ndarray:
+def far_fibre_axis(layer: Any, system: Any, verts: np.ndarray, axis_y: float,
+                   r_stretched: float) -> np.ndarray:
     """The nominal axis at vertices ``verts`` of the wrapped rod (module docstring): the
     far fibre, opposite the direction to the cylinder axis (the line y = ``axis_y``, z = 0
     along x), moved toward it by ``r_stretched`` [m] (the far fibre of the section about
@@ -186,7 +186,7 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
         stretch = float(0.5 * (e[mid - 1] + e[mid]) / (2.0 * half / n_rod))
         r_str = 0.5 * d0 / math.sqrt(stretch)
         near = rod_v[mid - 3:mid + 4]
-        nominal = _far_fibre_axis(layer, system, near, y_obs, r_str)
+        nominal = far_fibre_axis(layer, system, near, y_obs, r_str)
         seg = np.linalg.norm(np.diff(nominal, axis=0), axis=1)
         trib = 0.5 * (seg[2] + seg[3])
         f_mid = float(np.linalg.norm(g[rod_v[mid]])) / trib
