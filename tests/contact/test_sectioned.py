@@ -720,3 +720,31 @@ def test_the_reported_traction_is_the_one_the_energy_applies(step: float) -> Non
         reported = float(per_edge[:24] @ rest[:24])
         assert force > 0.0
         assert reported == pytest.approx(force, rel=0.05)
+
+
+def test_on_a_straight_partner_the_passes_weights_sum_to_one() -> None:
+    # The partner's surface is blended over its edges by hats that sum to one along a
+    # straight partner (the calibration's and the cross-check's straight scenes rely on
+    # it; on a bent one they do not: bench/partition_sum.py). Two straight rods crossing
+    # over a vertex of B: every sample of A in contact gets weights summing to one.
+    mat = Material(1.25e6, 0.5, 1160.0)
+    b = RodBuilder(twist=False)
+    z = np.linspace(-1.5 * D0, 1.5 * D0, 25)
+    b.add_rod(np.c_[np.full(25, 0.3 * D0 / 12), np.zeros(25), z], D0, mat)
+    b.add_rod(np.c_[z, np.full(25, 0.97 * D0), np.zeros(25)], D0, mat)
+    model = b.finalize()
+    system = RodSystem(model, State.initial(model), BoundaryConditions(model))
+    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=64))
+    system.add_term(layer)
+    st = system.state
+    owner, partner, pen, weight = layer.sample_passes(st.x, np.zeros(layer.dof_count),
+                                                      st.frames, system.rest)
+    assert owner.shape == partner.shape and pen.shape == weight.shape == (owner.size, 2, 64)
+    assert np.all(model.edge_rod[owner] != model.edge_rod[partner])
+    on_a = owner < 24
+    sums = np.zeros((24, 2, 64))
+    hit = np.zeros((24, 2, 64), dtype=bool)
+    np.add.at(sums, owner[on_a], weight[on_a])
+    np.logical_or.at(hit, owner[on_a], (pen[on_a] > 0.0) & (weight[on_a] > 0.0))
+    assert hit.sum() > 20
+    assert np.allclose(sums[hit], 1.0, rtol=0.0, atol=1e-12)

@@ -987,6 +987,28 @@ class SectionedLayer(ContactLayer):
             return np.asarray(x, dtype=np.float64)
         return self.shift.at(x, np.asarray(rest, dtype=np.float64)).x
 
+    def sample_passes(self, x: np.ndarray, extra: np.ndarray,
+                      frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every pass of the candidate pairs at the boundaries' centres ``x`` [m] (sections
+        ``extra`` [m], ``frames``, edge rest lengths ``rest`` [m]): its sample edge
+        (``owner``, A), the partner edge whose surface it samples (``partner``, B), and
+        per Gauss circle and boundary sample of A the penetration [m] into B's surface and
+        the weight the energy gives it (B's partition of unity times the exclusion ramp;
+        0 where the pass skips the sample). Shapes (P,), (P,), (P, G, M), (P, G, M)."""
+        wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
+        ng, ms = len(self.settings.gauss[0]), self.section.samples
+        if not pairs.shape[0]:
+            empty = np.zeros((0, ng, ms))
+            return np.zeros(0, np.int64), np.zeros(0, np.int64), empty, empty
+        data = self._state_arrays(extra, *frames, rest, arcs, rod_len, x)
+        out = self._launch(sk.REPORT, wx, pairs, data, report=True)
+        host = pairs.numpy().astype(np.int64)
+        # thread 2 p samples pair p's first edge against its second, 2 p + 1 the reverse
+        owner = np.stack([host[:, 0], host[:, 1]], axis=1).reshape(-1)
+        partner = np.stack([host[:, 1], host[:, 0]], axis=1).reshape(-1)
+        return owner, partner, out["pen"], out["weight"]
+
     def section_report(self, x: np.ndarray, extra: np.ndarray,
                        frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
                        ) -> dict[str, np.ndarray]:
@@ -1017,29 +1039,24 @@ class SectionedLayer(ContactLayer):
         ng = len(self.settings.gauss[0])
         ms = self.section.samples
         x = self.boundary_centres(x, rest)  # the boundaries' centres and mean stretch
-        wx, pairs, arcs, rod_len = self._candidates(x, extra, rest)
-        data = self._state_arrays(extra, *frames, rest, arcs, rod_len, x)
         emod = self.edge_modulus
         press = np.zeros((n_e, ng, ms))
-        if pairs.shape[0]:
-            out = self._launch(sk.REPORT, wx, pairs, data, report=True)
-            host = pairs.numpy().astype(np.int64)
-            owner = np.stack([host[:, 0], host[:, 1]], axis=1).reshape(-1)  # pass -> its A
+        owner, partner, pen, weight = self.sample_passes(x, extra, frames, rest)
+        if owner.size:
             # The traction the energy applies at a sample: the penalty's slope in each
             # partner edge's pass, weighed as the energy weighs it (the partition of unity
             # over the partner's edges, the exclusion ramp), summed over the passes. The
             # largest pass alone would report a neighbour edge's surface, extended with a
             # small weight, wherever the partner's radius steps at a vertex.
-            e_a, e_b = host[:, 0], host[:, 1]
-            e_pair = 2.0 * emod[e_a] * emod[e_b] / (emod[e_a] + emod[e_b])
-            d_pair = self.edge_r0[e_a] + self.edge_r0[e_b]
+            e_pair = 2.0 * emod[owner] * emod[partner] / (emod[owner] + emod[partner])
+            d_pair = self.edge_r0[owner] + self.edge_r0[partner]
             penalty = self.penalty * self.penalty_scale  # the kernels' (the homotopy's)
-            kappa = np.repeat(penalty * e_pair / d_pair, 2)[:, None, None]
-            onset = np.repeat(self.section.onset * d_pair, 2)[:, None, None]
-            g = np.maximum(out["pen"], 0.0)
+            kappa = (penalty * e_pair / d_pair)[:, None, None]
+            onset = (self.section.onset * d_pair)[:, None, None]
+            g = np.maximum(pen, 0.0)
             dphi = np.where(g < onset, kappa * g * g / (2.0 * onset),
                             kappa * (g - 0.5 * onset))
-            t = np.maximum(out["weight"], 0.0) * dphi
+            t = np.maximum(weight, 0.0) * dphi
             touch = np.flatnonzero((t > 0.0).any(axis=(1, 2)))  # the passes in contact
             np.add.at(press, owner[touch], t[touch])
         # the deformed boundary's length element r ds at each sample, per Gauss circle
