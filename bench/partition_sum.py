@@ -13,7 +13,7 @@ kappa its curvature), towards each other on the concave side and apart on the co
 so the hats there sum to more or less than one. Part 1 evaluates the sum at points 0.97 R
 from a polyline bent at kappa R (12 edges per D0, the cross-check's resolution); part 2
 reads it at every sample in contact of the study's knots tied at the sectioned level
-(:meth:`tightknot.contact.sectioned.SectionedLayer.sample_passes`), with the mean weighed
+(:meth:`tightknot.contact.sectioned.SectionedLayer.weight_sums`), with the mean weighed
 by each sample's penetration.
 """
 
@@ -79,15 +79,7 @@ def knot_sums(which: str, nodes_closed: int = 100, nodes_open: int = 150) -> dic
     layer = next(t for t in system.extra_terms if isinstance(t, SectionedLayer))
     st = system.state
     x = layer.boundary_centres(st.x, system.rest)
-    owner, _, pen, weight = layer.sample_passes(x, st.extra, st.frames, system.rest)
-    n_e = layer.model.edge_count
-    shape = (n_e,) + pen.shape[1:]
-    w_sum, w_pen = np.zeros(shape), np.zeros(shape)
-    w = np.maximum(weight, 0.0)
-    np.add.at(w_sum, owner, w)
-    np.add.at(w_pen, owner, w * np.maximum(pen, 0.0))
-    touch = w_pen > 0.0
-    sums, pens = w_sum[touch], w_pen[touch]
+    sums, pens = layer.weight_sums(x, st.extra, st.frames, system.rest)
     return {"knot": which, "converged": bool(res.converged), "samples_in_contact": int(sums.size),
             "percentiles_5_25_50_75_95": np.percentile(sums, [5, 25, 50, 75, 95]).tolist(),
             "min": float(sums.min()), "max": float(sums.max()),

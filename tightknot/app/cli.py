@@ -167,7 +167,8 @@ def _cmd_tie(args: argparse.Namespace) -> int:
         keys = ("knot_type", "converged", "load_steps", "stretch", "L_over_D", "lambda_oc",
                 "pull_force_N", "min_gap_over_D0", "min_area_ratio",
                 "max_contact_width_fraction", "max_pressure_over_E", "max_approach_w_over_D0",
-                "calibrated_w_over_D0", "section_path", "newton_iterations", "wall_time_s")
+                "calibrated_w_over_D0", "contact_weight_sum_mean", "section_path",
+                "newton_iterations", "wall_time_s")
         for k in keys:
             if summary.get(k) is not None:
                 print(f"  {k:28s} {summary[k]}")

@@ -30,6 +30,9 @@ class ContactReport:
         peak_pressure_over_E: peak contact pressure over E [-].
         area_ratio: section area A/A0 from stretch and squeeze (incompressible) [-].
         pairs: contact point pairs (i, j) as vertex indices with their overlap [m].
+        weight_sum_mean: the sectioned level's mean sum of a contact sample's passes'
+            weights (one along straight partners; docs/sectioned_level.md, "The partner's
+            partition of unity on a bent partner"); None at the other levels.
     """
 
     overlap: np.ndarray
@@ -41,6 +44,7 @@ class ContactReport:
     peak_pressure_over_E: np.ndarray
     area_ratio: np.ndarray
     pairs: np.ndarray
+    weight_sum_mean: float | None = None
 
 
 def _segment_closest(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
@@ -161,6 +165,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
             w1v, dv)
         area = law.area_factor(0.5 * (w1v + w2v), dv) / stretch_v
     force = f_line * emod
+    weight_sum = None
     if isinstance(layer, SectionedLayer):
         if state is None:
             raise ValueError("the sectioned contact level's report needs the state (its "
@@ -170,8 +175,9 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
         half, lc, area = sec["half_width"], sec["contact_width_fraction"], sec["area_ratio"]
         p_mean, p_peak = sec["mean_pressure_over_E"], sec["peak_pressure_over_E"]
         force = sec["force_per_length"]
+        weight_sum = sec["contact_weight_sum_mean"]
     return ContactReport(
         overlap=2.0 * w1v, overlap_opposite=2.0 * w2v,
         force_per_length=force, half_width=half, contact_width_fraction=lc,
         mean_pressure_over_E=p_mean, peak_pressure_over_E=p_peak, area_ratio=area,
-        pairs=pair_list)
+        pairs=pair_list, weight_sum_mean=weight_sum)

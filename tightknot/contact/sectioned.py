@@ -1009,6 +1009,20 @@ class SectionedLayer(ContactLayer):
         partner = np.stack([host[:, 1], host[:, 0]], axis=1).reshape(-1)
         return owner, partner, out["pen"], out["weight"]
 
+    def weight_sums(self, x: np.ndarray, extra: np.ndarray,
+                    frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray,
+                    edges: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """At every sample in contact (of ``edges``, default all; arguments as
+        :meth:`sample_passes`): the sum of its passes' weights, one along a straight
+        partner and not along a bent one (docs/sectioned_level.md, "The partner's
+        partition of unity on a bent partner"), and its weighted penetration [m]."""
+        owner, _, pen, weight = self.sample_passes(x, extra, frames, rest)
+        sums, pens = _per_sample(owner, pen, weight, self.model.edge_count)
+        if edges is not None:
+            sums, pens = sums[edges], pens[edges]
+        touch = pens > 0.0
+        return sums[touch], pens[touch]
+
     def section_report(self, x: np.ndarray, extra: np.ndarray,
                        frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
                        ) -> dict[str, np.ndarray]:
@@ -1026,6 +1040,10 @@ class SectionedLayer(ContactLayer):
         * ``force_per_length``: the contact force per unit rest length [N/m] (sum of the
           samples' tractions times their rest area, over the edge; per edge too,
           ``force_per_length_edges``);
+        * ``contact_weight_sum_mean``: over the samples in contact, the sum of each one's
+          passes' weights (one along a straight partner, not along a bent one:
+          :meth:`weight_sums`), their mean weighed by the weighted penetration (a number;
+          0 without contact);
         * ``half_width``: L_c pi D0 / 4 [m], the half-width of each of two opposite
           contacts sharing the width;
         * ``area_ratio``: A/A0 = lambda^(-2 nu), lambda the stretch of the vertex's edges
@@ -1042,6 +1060,7 @@ class SectionedLayer(ContactLayer):
         emod = self.edge_modulus
         press = np.zeros((n_e, ng, ms))
         owner, partner, pen, weight = self.sample_passes(x, extra, frames, rest)
+        weight_sum = _weight_sum_mean(owner, pen, weight, n_e)
         if owner.size:
             # The traction the energy applies at a sample: the penalty's slope in each
             # partner edge's pass, weighed as the energy weighs it (the partition of unity
@@ -1098,6 +1117,7 @@ class SectionedLayer(ContactLayer):
                 "mean_pressure_over_E": to_vertex(mean_p.max(axis=1) / emod),
                 "force_per_length": to_vertex(f_len),
                 "force_per_length_edges": f_len,
+                "contact_weight_sum_mean": weight_sum,
                 "half_width": 0.25 * math.pi * to_vertex(d0) * lc,
                 "area_ratio": stretch_v ** (-2.0 * nu_v)}
 
@@ -1156,3 +1176,26 @@ def _rotate(c: np.ndarray, modes: np.ndarray, angle: np.ndarray, transpose: bool
     out[:, 0::2] = cs * a + sn * b
     out[:, 1::2] = -sn * a + cs * b
     return out
+
+
+def _per_sample(owner: np.ndarray, pen: np.ndarray, weight: np.ndarray, edge_count: int
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Per edge, Gauss circle and sample: the sum of the passes' weights and the weighted
+    penetration [m] (the passes of :meth:`SectionedLayer.sample_passes`)."""
+    shape = (edge_count,) + pen.shape[1:]
+    sums, pens = np.zeros(shape), np.zeros(shape)
+    w = np.maximum(weight, 0.0)
+    np.add.at(sums, owner, w)
+    np.add.at(pens, owner, w * np.maximum(pen, 0.0))
+    return sums, pens
+
+
+def _weight_sum_mean(owner: np.ndarray, pen: np.ndarray, weight: np.ndarray,
+                     edge_count: int) -> float:
+    """The mean over the samples in contact of their passes' weight sums, weighed by their
+    weighted penetration (0 without contact)."""
+    if not owner.size:
+        return 0.0
+    sums, pens = _per_sample(owner, pen, weight, edge_count)
+    total = float(pens.sum())
+    return float((sums * pens).sum() / total) if total > 0.0 else 0.0

@@ -176,6 +176,7 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
             "tension_over_e_d0sq": tension / (youngs_modulus * d0**2),
             "approach_over_d0": (d0 - dist) / d0,
             "overlap_over_d0": float(rep.overlap[rod_v[mid]]) / d0,
+            "contact_weight_sum_mean": rep.weight_sum_mean,
             "axial_stretch_mid": float(voronoi / (2.0 * half / n_rod)),
             # on A (B carries A's and its mirror image's, which cancel)
             "contact_force_total": float(np.linalg.norm(g[rod_v].sum(axis=0))),
@@ -294,6 +295,7 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
             "force_over_e_d0sq": force / (youngs_modulus * d0**2),
             "approach_over_d0": (d0 - float(np.linalg.norm(xa[apex] - x[vb[apex]]))) / d0,
             "axial_stretch_apex": stretch,
+            "contact_weight_sum_mean": rep.weight_sum_mean,
             "kappa_d0_apex": float(bergou_curvature(xa, closed=False)[apex]) * d0,
             "area_ratio_apex": prof_a[0]["area_ratio"],
             "area_ratio_min": min(r["area_ratio"] for r in prof_a),
@@ -406,6 +408,7 @@ def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "area_ratio_mid_b": float(rep.area_ratio[b_v]),
             "peak_pressure_over_e": float(rep.peak_pressure_over_E[a_v]),
             "contact_width_fraction_mid": float(rep.contact_width_fraction[a_v]),
+            "contact_weight_sum_mean": rep.weight_sum_mean,
         }
 
     rows = _solve_levels(system, load, list(w_levels), measure)

@@ -74,6 +74,7 @@ def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "axial_stretch_mid": stretch, "area_ratio_mid": float(rep["area_ratio"][v]),
             "peak_pressure_over_e": float(rep["peak_pressure_over_E"][v]),
             "contact_width_fraction_mid": float(rep["contact_width_fraction"][v]),
+            "contact_weight_sum_mean": rep["contact_weight_sum_mean"],
         }
 
     rows = _solve_levels(system, load, list(w_levels), measure)
@@ -230,6 +231,7 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
             "force_per_length_mid_centroid": f_cent,
             "peak_pressure_over_e": float(rep["peak_pressure_over_E"][v]),
             "contact_width_fraction_mid": float(rep["contact_width_fraction"][v]),
+            "contact_weight_sum_mean": rep["contact_weight_sum_mean"],
             "force_per_length_mid_window_over_e_d0": f_win / (youngs_modulus * d0),
             "contact_axial_over_across_mid": (float(np.abs(axial[near_half]).max()) / top
                                               if top > 0.0 else 0.0),

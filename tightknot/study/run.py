@@ -249,6 +249,13 @@ def knot_title(closed: bool, knot_type: str) -> str:
     return f"{'closed' if closed else 'open'} {common.get(knot_type, f'{knot_type} knot')}"
 
 
+#: How far the sectioned level's mean sum of a contact sample's weights may stray from one
+#: before a summary warns: the penalty's own largest force error in the squeeze it was
+#: calibrated on is 8.1 % (N = 8, docs/sectioned_level.md), so a bias past 10 % is beyond
+#: what the calibration can tell.
+WEIGHT_SUM_TOLERANCE = 0.1
+
+
 def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | None = None,
                       rest: np.ndarray | None = None) -> dict[str, Any]:
     """Where the state stands against the range its contact law was calibrated in: the
@@ -260,7 +267,8 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
     incompressible solid; at the sectioned level, sections thinner than the FEM judged
     them, :attr:`~tightknot.contact.sectioned.SectionCalibration.judged_area_ratio`, and
     with its bend shift a bend tighter than the FEM measured the shift at,
-    :data:`~tightknot.contact.section_shift.MEASURED_KAPPA_R`)."""
+    :data:`~tightknot.contact.section_shift.MEASURED_KAPPA_R`, and contacts whose weights
+    stray from one by more than :data:`WEIGHT_SUM_TOLERANCE`: ``contact_weight_sum_mean``)."""
     law = scene.contact.law
     w_hat = 0.5 * float(np.max(contact.overlap, initial=0.0)) / scene.diameter
     warnings = []
@@ -295,11 +303,20 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
                 warnings.append(f"the sections' bend shift reaches kappa R = {kr:.3g}, beyond "
                                 f"the {MEASURED_KAPPA_R:.3g} at which the FEM measured it "
                                 "(docs/fem_nip.md; the shift there is extrapolated)")
+        weight_sum = contact.weight_sum_mean if sectioned else None
+        if weight_sum is not None and abs(weight_sum - 1.0) > WEIGHT_SUM_TOLERANCE:
+            warnings.append(f"the sections' contacts weigh {weight_sum:.3g} times on average "
+                            "where the penalty was calibrated at one: on a bent partner the "
+                            "weights that blend its edges do not sum to one (a known bias, "
+                            "docs/sectioned_level.md, 'The partner's partition of unity on a "
+                            "bent partner')")
         nus = {r.material.poisson_ratio for r in scene.model.rods}
         if any(abs(nu - 0.5) > 1e-12 for nu in nus):
             warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "
                             "calibrated on an incompressible solid (nu = 0.5): extrapolated")
     return {"max_approach_w_over_D0": w_hat,
+            "contact_weight_sum_mean": (contact.weight_sum_mean if sectioned and not law.rigid
+                                        else None),
             "calibrated_w_over_D0": None if law.rigid else limit,
             "max_crossing_w_over_D0": w_cross,
             "crossing_calibrated_w_over_D0": None if law.rigid else cross_limit,
