@@ -748,3 +748,10 @@ def test_on_a_straight_partner_the_passes_weights_sum_to_one() -> None:
     np.logical_or.at(hit, owner[on_a], (pen[on_a] > 0.0) & (weight[on_a] > 0.0))
     assert hit.sum() > 20
     assert np.allclose(sums[hit], 1.0, rtol=0.0, atol=1e-12)
+    rep = layer.section_report(st.x, np.zeros(layer.dof_count), st.frames, system.rest)
+    assert rep["contact_weight_sum_mean"] == pytest.approx(1.0, abs=1e-12)
+    # apart, no sample is in contact: no mean (a summary then has nothing to warn of)
+    x_apart = st.x.copy()
+    x_apart[25:, 1] += 2.0 * D0
+    rep = layer.section_report(x_apart, np.zeros(layer.dof_count), st.frames, system.rest)
+    assert rep["contact_weight_sum_mean"] is None

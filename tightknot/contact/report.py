@@ -32,7 +32,8 @@ class ContactReport:
         pairs: contact point pairs (i, j) as vertex indices with their overlap [m].
         weight_sum_mean: the sectioned level's mean sum of a contact sample's passes'
             weights (one along straight partners; docs/sectioned_level.md, "The partner's
-            partition of unity on a bent partner"); None at the other levels.
+            partition of unity on a bent partner"); None at the other levels and without
+            contact.
     """
 
     overlap: np.ndarray

@@ -1043,7 +1043,7 @@ class SectionedLayer(ContactLayer):
         * ``contact_weight_sum_mean``: over the samples in contact, the sum of each one's
           passes' weights (one along a straight partner, not along a bent one:
           :meth:`weight_sums`), their mean weighed by the weighted penetration (a number;
-          0 without contact);
+          None without contact);
         * ``half_width``: L_c pi D0 / 4 [m], the half-width of each of two opposite
           contacts sharing the width;
         * ``area_ratio``: A/A0 = lambda^(-2 nu), lambda the stretch of the vertex's edges
@@ -1191,11 +1191,11 @@ def _per_sample(owner: np.ndarray, pen: np.ndarray, weight: np.ndarray, edge_cou
 
 
 def _weight_sum_mean(owner: np.ndarray, pen: np.ndarray, weight: np.ndarray,
-                     edge_count: int) -> float:
+                     edge_count: int) -> float | None:
     """The mean over the samples in contact of their passes' weight sums, weighed by their
-    weighted penetration (0 without contact)."""
+    weighted penetration (None without contact)."""
     if not owner.size:
-        return 0.0
+        return None
     sums, pens = _per_sample(owner, pen, weight, edge_count)
     total = float(pens.sum())
-    return float((sums * pens).sum() / total) if total > 0.0 else 0.0
+    return float((sums * pens).sum() / total) if total > 0.0 else None
