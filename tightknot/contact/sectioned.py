@@ -1010,16 +1010,14 @@ class SectionedLayer(ContactLayer):
         return owner, partner, out["pen"], out["weight"]
 
     def weight_sums(self, x: np.ndarray, extra: np.ndarray,
-                    frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray,
-                    edges: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """At every sample in contact (of ``edges``, default all; arguments as
-        :meth:`sample_passes`): the sum of its passes' weights, one along a straight
+                    frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """At every sample in contact (arguments as :meth:`sample_passes`): the sum of
+        its passes' weights, one along a straight
         partner and not along a bent one (docs/sectioned_level.md, "The partner's
         partition of unity on a bent partner"), and its weighted penetration [m]."""
         owner, _, pen, weight = self.sample_passes(x, extra, frames, rest)
         sums, pens = _per_sample(owner, pen, weight, self.model.edge_count)
-        if edges is not None:
-            sums, pens = sums[edges], pens[edges]
         touch = pens > 0.0
         return sums[touch], pens[touch]
 

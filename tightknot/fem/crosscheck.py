@@ -87,6 +87,7 @@ from .crosscheck_soft import (
     finer_columns,
     finer_mesh,
     finer_summary,
+    same_levels,
     spread_mesh,
 )
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
@@ -140,8 +141,7 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
     for f, r, c, g in zip(fem_steps, rod_steps, spread, finer, strict=True):
         if f["approach_over_d0"] > limit + 1e-9:
             continue
-        if c is not None and any(k in f and k in c and not math.isclose(f[k], c[k])
-                                 for k in ("w_over_d0", "tension")):
+        if c is not None and not same_levels(f, c):
             c = None  # another load level: no spread to report
         row = {
             "approach_over_d0": f["approach_over_d0"],

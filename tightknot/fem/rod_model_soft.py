@@ -33,7 +33,7 @@ from .rod_model import (
     _solve_levels,
     wrap_scene,
 )
-from .rod_sectioned import far_fibre_axis
+from .rod_sectioned import axis_reading, far_fibre_axis
 
 CONTACT_LEVELS: tuple[str, ...] = ("compliant", "smoothed", "sectioned")
 """Contact levels of the rod model here (:func:`contact_term`)."""
@@ -159,9 +159,7 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
             r_str = 0.5 * d0 / math.sqrt(voronoi / (2.0 * half / n_rod))
             near = rod_v[mid - 3:mid + 4]
             nominal = far_fibre_axis(term, system, near, y_obs, r_str)
-            seg = np.linalg.norm(np.diff(nominal, axis=0), axis=1)
-            f_mid = float(np.linalg.norm(g[rod_v[mid]]) / (0.5 * (seg[2] + seg[3])))
-            kappa = float(bergou_curvature(nominal, closed=False)[3])
+            f_mid, kappa = axis_reading(nominal, float(np.linalg.norm(g[rod_v[mid]])))
             xm = nominal[3]
         else:
             f_mid = float(np.linalg.norm(g[rod_v[mid]]) / voronoi)

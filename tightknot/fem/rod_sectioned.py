@@ -124,6 +124,17 @@ def far_fibre_axis(layer: Any, system: Any, verts: np.ndarray, axis_y: float,
     return out
 
 
+def axis_reading(axis: np.ndarray, force: float) -> tuple[float, float]:
+    """On an axis through seven vertices centred on a wrap's middle (``axis`` [m]): the
+    middle's line load, the contact force ``force`` [N] per its tributary length [N/m],
+    and the axis's curvature there [1/m]."""
+    from tightknot.knots.curvature import bergou_curvature
+
+    seg = np.linalg.norm(np.diff(axis, axis=0), axis=1)
+    return (float(force / (0.5 * (seg[2] + seg[3]))),
+            float(bergou_curvature(axis, closed=False)[3]))
+
+
 def _centroid_axis(layer: Any, system: Any, verts: np.ndarray) -> np.ndarray:
     """The centroids [m] of the deformed sections at vertices ``verts`` of rod 0: the
     boundary's centre x_v (:meth:`~tightknot.contact.sectioned.SectionedLayer.
@@ -188,15 +199,10 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
         r_str = 0.5 * d0 / math.sqrt(stretch)
         near = rod_v[mid - 3:mid + 4]
         nominal = far_fibre_axis(layer, system, near, y_obs, r_str)
-        seg = np.linalg.norm(np.diff(nominal, axis=0), axis=1)
-        trib = 0.5 * (seg[2] + seg[3])
-        f_mid = float(np.linalg.norm(g[rod_v[mid]])) / trib
-        kappa = float(bergou_curvature(nominal, closed=False)[3])
+        f_mid, kappa = axis_reading(nominal, float(np.linalg.norm(g[rod_v[mid]])))
         kappa_c = float(bergou_curvature(xr, closed=False)[mid])
         cent = _centroid_axis(layer, system, near)
-        seg_c = np.linalg.norm(np.diff(cent, axis=0), axis=1)
-        f_cent = float(np.linalg.norm(g[rod_v[mid]])) / (0.5 * (seg_c[2] + seg_c[3]))
-        kappa_cent = float(bergou_curvature(cent, closed=False)[3])
+        f_cent, kappa_cent = axis_reading(cent, float(np.linalg.norm(g[rod_v[mid]])))
         dist = math.hypot(y_obs - nominal[3, 1], nominal[3, 2])
         v = rod_v[mid]
         # the contact term's forces on the rod's vertices, split along and across its

@@ -303,7 +303,7 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
                 warnings.append(f"the sections' bend shift reaches kappa R = {kr:.3g}, beyond "
                                 f"the {MEASURED_KAPPA_R:.3g} at which the FEM measured it "
                                 "(docs/fem_nip.md; the shift there is extrapolated)")
-        weight_sum = contact.weight_sum_mean if sectioned else None
+        weight_sum = contact.weight_sum_mean  # None but at the sectioned level
         if weight_sum is not None and abs(weight_sum - 1.0) > WEIGHT_SUM_TOLERANCE:
             warnings.append(f"the sections' contacts weigh {weight_sum:.3g} times on average "
                             "where the penalty was calibrated at one: on a bent partner the "
@@ -315,8 +315,7 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
             warnings.append(f"the rod has Poisson ratio {min(nus):g}, the contact law was "
                             "calibrated on an incompressible solid (nu = 0.5): extrapolated")
     return {"max_approach_w_over_D0": w_hat,
-            "contact_weight_sum_mean": (contact.weight_sum_mean if sectioned and not law.rigid
-                                        else None),
+            "contact_weight_sum_mean": contact.weight_sum_mean,
             "calibrated_w_over_D0": None if law.rigid else limit,
             "max_crossing_w_over_D0": w_cross,
             "crossing_calibrated_w_over_D0": None if law.rigid else cross_limit,
