@@ -20,7 +20,6 @@ from tightknot.contact.sectioned_reference import (
     PairSettings,
     mode_rotation,
     pair_terms,
-    swap_order,
 )
 from tightknot.rods.boundary import BoundaryConditions
 from tightknot.rods.builder import RodBuilder
@@ -40,10 +39,23 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _pair(seed: int = 1) -> tuple[EdgeSection, EdgeSection]:
+def _bend(x0: np.ndarray, x1: np.ndarray, towards: np.ndarray, angle: float
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """The neighbours of edge x0 x1 on a rod that turns by ``angle`` [rad] at each vertex
+    towards ``towards`` (their edges as long as this one, 0.9 and 1.1 times)."""
+    e = x1 - x0
+    t = _unit(e)
+    n = _unit(towards - (towards @ t) * t)
+    return (x0 - 0.9 * (math.cos(angle) * e + math.sin(angle) * np.linalg.norm(e) * n),
+            x1 + 1.1 * (math.cos(angle) * e + math.sin(angle) * np.linalg.norm(e) * n))
+
+
+def _pair(seed: int = 1, bend: float = 0.0) -> tuple[EdgeSection, EdgeSection]:
     """Two short crossing edges of unit-diameter rods overlapping by about 0.03 D, with
     random sections, frames carried from slightly different accepted tangents and a
-    reference twist to the next edge's frame (D = 1: lengths in diameters)."""
+    reference twist to the next edge's frame (D = 1: lengths in diameters). With ``bend``
+    [rad], each edge's rod turns by that much at its vertices, towards the other rod
+    (b's neighbours 0.9 and 1.1 edges long)."""
     rng = np.random.default_rng(seed)
 
     def edge(x0: np.ndarray, x1: np.ndarray, arc: tuple[float, float]) -> EdgeSection:
@@ -53,24 +65,41 @@ def _pair(seed: int = 1) -> tuple[EdgeSection, EdgeSection]:
                            twist1=0.3 * rng.normal(), rest=0.97 * float(np.linalg.norm(x1 - x0)),
                            r0=0.5, arc=arc)
 
-    return (edge(np.array([-0.05, 0.0, 0.0]), np.array([0.05, 0.01, 0.0]), (0.0, 0.1)),
-            edge(np.array([0.01, -0.04, 0.985]), np.array([-0.01, 0.06, 1.0]), (3.0, 3.1)))
+    a = edge(np.array([-0.05, 0.0, 0.0]), np.array([0.05, 0.01, 0.0]), (0.0, 0.1))
+    b = edge(np.array([0.01, -0.04, 0.985]), np.array([-0.01, 0.06, 1.0]), (3.0, 3.1))
+    if bend:
+        a.x_prev, a.x_next = _bend(a.x0, a.x1, np.array([0.0, 0.0, 1.0]), bend)
+        b.x_prev, b.x_next = _bend(b.x0, b.x1, np.array([0.0, 0.0, -1.0]), bend)
+    return a, b
 
 
 SETTINGS = PairSettings(modes=MODES, gauss_xi=GAUSS[0], gauss_w=GAUSS[1], samples=32,
                         kappa=1000.0, onset=1e-4)
 
 
+def _near(e: EdgeSection) -> list[np.ndarray]:
+    """An edge's neighbouring vertices (the ghosts' positions where it has none)."""
+    return [2.0 * e.x0 - e.x1 if e.x_prev is None else e.x_prev,
+            2.0 * e.x1 - e.x0 if e.x_next is None else e.x_next]
+
+
 def _pack(a: EdgeSection, b: EdgeSection) -> np.ndarray:
     return np.concatenate([a.x0, a.x1, b.x0, b.x1, a.coeffs0, a.coeffs1, b.coeffs0,
-                           b.coeffs1])
+                           b.coeffs1, *_near(a), *_near(b)])
 
 
 def _unpack(a: EdgeSection, b: EdgeSection, q: np.ndarray) -> tuple[EdgeSection, EdgeSection]:
     a, b = copy.copy(a), copy.copy(b)
     a.x0, a.x1, b.x0, b.x1 = q[0:3], q[3:6], q[6:9], q[9:12]
     a.coeffs0, a.coeffs1 = q[12:12 + K], q[12 + K:12 + 2 * K]
-    b.coeffs0, b.coeffs1 = q[12 + 2 * K:12 + 3 * K], q[12 + 3 * K:]
+    b.coeffs0, b.coeffs1 = q[12 + 2 * K:12 + 3 * K], q[12 + 3 * K:12 + 4 * K]
+    nb = 12 + 4 * K
+    # a ghost neighbour is no dof: it follows its edge's vertices
+    for edge, at in ((a, nb), (b, nb + 6)):
+        if edge.x_prev is not None:
+            edge.x_prev = q[at:at + 3]
+        if edge.x_next is not None:
+            edge.x_next = q[at + 3:at + 6]
     return a, b
 
 
@@ -107,63 +136,108 @@ def test_oracle_derivatives_match_finite_differences() -> None:
     assert np.linalg.norm(h - h_fd) / np.linalg.norm(h_fd) < 1e-3
 
 
+def _pass_to_pair(flip: int) -> np.ndarray:
+    """The pair's local dof (oracle order: x_a0, x_a1, x_b0, x_b1, the four vertices'
+    coefficients, x_a_prev, x_a_next, x_b_prev, x_b_next) of each local dof of the kernel's
+    pass ``flip`` (x_A0, x_A1, x_B0, x_B1, the coefficients, x_Bprev, x_Bnext; pass 1 takes
+    A = b)."""
+    nb = 12 + 4 * K
+    if flip == 0:
+        return np.r_[0:nb, nb + 6:nb + 12]
+    return np.r_[6:12, 0:6, 12 + 2 * K:12 + 4 * K, 12:12 + 2 * K, nb:nb + 6]
+
+
 def _kernel_pass(a: EdgeSection, b: EdgeSection, rigid_b: bool, gauss_newton: int = 0
                  ) -> tuple[float, np.ndarray, np.ndarray]:
     """Energy, gradient and Hessian of the pair from the Warp kernel (both passes, node
-    blocks unpacked to the pair's local dofs); ``gauss_newton``: its Gauss-Newton
-    Hessian."""
+    blocks unpacked to the pair's local dofs, :func:`_pass_to_pair`); ``gauss_newton``:
+    its Gauss-Newton Hessian. Vertices 4 .. 7 are a's and b's neighbours (x_prev, x_next;
+    a ghost where the edge has none)."""
     f = wp.float64
 
     def arr(x, dt):
         return wp.array(np.asarray(x), dtype=dt)
 
-    nl = 12 + 4 * K
+    nl = 18 + 4 * K
+    npair = 24 + 4 * K
     phi = 2.0 * np.pi * (np.arange(32) + 0.5) / 32
-    offs = [0, K, -1 if rigid_b else 2 * K, -1 if rigid_b else 3 * K]
+    offs = [0, K, -1 if rigid_b else 2 * K, -1 if rigid_b else 3 * K, -1, -1, -1, -1]
+    near = [[4 if a.x_prev is not None else -1, 5 if a.x_next is not None else -1],
+            [6 if b.x_prev is not None else -1, 7 if b.x_next is not None else -1]]
     model = [arr([[0, 1], [2, 3]], wp.vec2i), arr([0, 1], wp.int32), arr([0, 0], wp.int32),
              arr([0.5, 0.5], f), arr([0.5, 0.5], f), arr([1.0, 1.0], f),
              arr([0, int(rigid_b)], wp.int32), arr(offs, wp.int32),
-             arr([[0, 0], [0, 0]], wp.vec2i), arr([0.0, 0.0], f), arr(GAUSS[0], f),
+             arr([[int(a.first_open), int(a.last_open)], [int(b.first_open), int(b.last_open)]],
+                 wp.vec2i), arr([0.0, 0.0], f), arr(GAUSS[0], f),
              arr(GAUSS[1], f), arr(np.cos(phi), f), arr(np.sin(phi), f), K, 32, 1000.0,
-             1e-4, 0, gauss_newton]
-    x = arr(np.array([a.x0, a.x1, b.x0, b.x1]), wp.vec3d)
+             1e-4, 0, gauss_newton, arr(near, wp.vec2i)]
+
+    def ghost(p, q, other):
+        return 2.0 * q - other if p is None else p
+
+    x = arr(np.array([a.x0, a.x1, b.x0, b.x1, ghost(a.x_prev, a.x0, a.x1),
+                      ghost(a.x_next, a.x1, a.x0), ghost(b.x_prev, b.x0, b.x1),
+                      ghost(b.x_next, b.x1, b.x0)]), wp.vec3d)
     coeff = arr(np.concatenate([a.coeffs0, a.coeffs1, b.coeffs0, b.coeffs1]), f)
     rest, lam = arr([a.rest, b.rest], f), arr([1.0], f)
-    bounds = [wp.zeros(4, dtype=f), wp.zeros(2, dtype=f)]  # per vertex, per edge
-    wp.launch(sk.section_bounds, 6, [model[0], model[7], model[3], model[4], model[6], K, 0,
-                                     x, coeff, rest, lam], bounds)
+    bounds = [wp.zeros(8, dtype=f), wp.zeros(2, dtype=f)]  # per vertex, per edge
+    wp.launch(sk.section_bounds, 10, [model[0], model[7], model[3], model[4], model[6], K, 0,
+                                      x, coeff, rest, lam], bounds)
+    # node-pair blocks of the 8 vertices; each pass's 6 nodes (a ghost: B's first vertex)
+    nodes = [[0, 1, 2, 3, near[1][0] if near[1][0] >= 0 else 2,
+              near[1][1] if near[1][1] >= 0 else 2],
+             [2, 3, 0, 1, near[0][0] if near[0][0] >= 0 else 0,
+              near[0][1] if near[0][1] >= 0 else 0]]
+    slots = np.array([[8 * n + m for n in nd for m in nd] for nd in nodes]).ravel()
     data = [x, coeff,
             arr([a.t_ref, b.t_ref], wp.vec3d), arr([a.d1_ref, b.d1_ref], wp.vec3d),
             arr([a.twist1, b.twist1], f), rest,
             arr([a.arc, b.arc], wp.vec2d), arr([1.0, 1.0], f), lam, *bounds,
-            arr([[0, 1]], wp.vec2i), arr(np.arange(16), wp.int32)]
+            arr([[0, 1]], wp.vec2i), arr(slots, wp.int32)]
     bsz = 3 + K
     outs = [wp.zeros(2, dtype=f), wp.zeros(2 * nl, dtype=f),
-            wp.zeros(16 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f),
+            wp.zeros(64 * bsz * bsz, dtype=f), wp.zeros(1, dtype=f), wp.zeros(1, dtype=f),
             wp.zeros(1, dtype=f), wp.zeros(4 * nl, dtype=f)]
     wp.launch(sk.DERIVATIVES, 2, model + data, outs)
     g = outs[1].numpy().reshape(2, nl)
-    grad = g[0].copy()
-    grad[swap_order(K)] += g[1]
-    blocks = outs[2].numpy().reshape(4, 4, bsz, bsz)
-    # node n's local dofs: positions 3n..3n+2, sections 12 + K n ..
+    grad = np.zeros(npair)
+    for flip in range(2):
+        grad[_pass_to_pair(flip)] += g[flip]
+    blocks = outs[2].numpy().reshape(8, 8, bsz, bsz)
+    # vertex n's pair dofs: positions, then its coefficients (none for 4 .. 7)
+    nb = 12 + 4 * K
     local = [np.r_[3 * n:3 * n + 3, 12 + K * n:12 + K * (n + 1)] for n in range(4)]
-    hess = np.zeros((nl, nl))
-    for i in range(4):
-        for j in range(4):
-            hess[np.ix_(local[i], local[j])] += blocks[i, j]
-    _kernel_pass.twist = outs[6].numpy().reshape(2, 2, nl)  # pass, side (A, B), local dof
+    local += [np.r_[nb + 3 * j:nb + 3 * j + 3] for j in range(4)]
+    hess = np.zeros((npair, npair))
+    for i in range(8):
+        for j in range(8):
+            rows, cols = local[i], local[j]
+            hess[np.ix_(rows, cols)] += blocks[i, j][:rows.size, :cols.size]
+    tw = outs[6].numpy().reshape(2, 2, nl)  # pass, side (A, B), pass-local dof
+    _kernel_pass.twist = np.zeros((2, 2, npair))
+    for flip in range(2):
+        for side in range(2):
+            _kernel_pass.twist[flip, side, _pass_to_pair(flip)] = tw[flip, side]
     return float(outs[0].numpy().sum()), grad, hess
 
 
-@pytest.mark.parametrize("rigid_b", [False, True])
-def test_kernel_matches_the_oracle(rigid_b: bool) -> None:
-    a, b = _pair()
+def _keep(rigid_b: bool) -> np.ndarray:
+    """The pair's dofs but a rigid b's coefficients."""
+    return (np.r_[0:12 + 2 * K, 12 + 4 * K:24 + 4 * K] if rigid_b
+            else np.r_[0:24 + 4 * K])
+
+
+@pytest.mark.parametrize(("rigid_b", "bend"), [(False, 0.0), (True, 0.0), (False, 0.4),
+                                               (True, 0.4)])
+def test_kernel_matches_the_oracle(rigid_b: bool, bend: float) -> None:
+    # straight rods (the neighbours ghosts) and rods bent 0.4 rad at each vertex towards
+    # each other (the partition's chords from real neighbours)
+    a, b = _pair(bend=bend)
     b.rigid = rigid_b
     ref = pair_terms(a, b, SETTINGS)
     assert ref["energy"] > 0.0  # a contact (seed 3's deformable pair touches nowhere)
     energy, grad, hess = _kernel_pass(a, b, rigid_b)
-    keep = np.r_[0:12 + 2 * K] if rigid_b else np.r_[0:12 + 4 * K]  # b rigid: no dofs
+    keep = _keep(rigid_b)  # b rigid: no dofs
     # the same formulas in float64, the frames' differences included: round-off only
     # (measured 1e-15 for energy and gradient, 8e-13 for the Hessian)
     assert energy == pytest.approx(ref["energy"], rel=1e-12)
@@ -201,7 +275,7 @@ def test_the_gauss_newton_hessian_is_the_penetrations_outer_products(rigid_b: bo
         d2phi = rounded_penalty(pen, SETTINGS.kappa, SETTINGS.onset)[2]
         c = np.where((pen > 0.0) & (wt > 0.0), a_s * wt * d2phi, 0.0)
         expected += jac[side].T @ (c[:, None] * jac[side])
-    keep = np.r_[0:12 + 2 * K] if rigid_b else np.r_[0:12 + 4 * K]
+    keep = _keep(rigid_b)
     ex = expected[np.ix_(keep, keep)]
     # the penetrations are smooth: their differences carry truncation eps^2 and round-off
     # 1e-16 / eps (measured 5e-10 and 4e-10 of the largest entry)
@@ -219,10 +293,8 @@ def test_kernel_twist_columns_are_the_gradients_derivatives_in_the_end_twists() 
     a, b = _pair()
     _kernel_pass(a, b, False)
     cols = _kernel_pass.twist
-    order = swap_order(K)
     for edge, own, other in ((a, (0, 0), (1, 1)), (b, (0, 1), (1, 0))):
-        col = cols[own].copy()
-        col[order] += cols[other]
+        col = cols[own] + cols[other]
         eps = 1e-6
         edge.twist1 += eps
         hi = pair_terms(a, b, SETTINGS)["grad"]

@@ -46,19 +46,22 @@ def test_the_sectioned_wrap_carries_the_line_load_and_the_width(wrap_coarse: dic
                     "kappa_d0_mid_nominal", width_scene="wrap")
     rows = comp["levels"]
     assert len(rows) >= 4
-    for row in rows[1:]:  # the first level's light contact is missed (module docstring)
+    for row in rows[1:]:
         assert row["rod_converged"]
-        assert abs(row["force_rel"]) <= 0.15, row  # 10 % target, 5 % the coarse mesh's own
         assert abs(row["area_points"]) <= 0.05, row
         assert abs(row["width_fraction"]) <= 0.10, row
+    # the line load from the third level on (the first two light contacts are missed:
+    # module docstring)
+    for row in rows[2:]:
+        assert abs(row["force_rel"]) <= 0.15, row  # 10 % target, 5 % the coarse mesh's own
     # the compliant level misses this line load by 15 to 31 % (docs/fem_crosscheck.md): the
     # sections carry it
     assert sum(abs(r["force_rel"]) <= 0.10 for r in rows[1:]) >= len(rows) - 2
-    # the wrapped rod bends: the samples of the straight cylinder on its concave side weigh
-    # more than one (medium FEM's tensions: 1.05 to 1.23 in the mean over both passes),
-    # the bias a normalised partition would remove (docs/sectioned_level.md)
+    # the wrapped rod bends: the straight cylinder's samples lie on its concave side, where
+    # the partner's weights still sum to one (they telescope over its chords; the
+    # projection hats they replaced summed to 1.05 to 1.23 here)
     sums = [s["contact_weight_sum_mean"] for s in rod["steps"]]
-    assert all(x > 1.02 for x in sums) and max(sums) > 1.1
+    assert all(x == pytest.approx(1.0, abs=1e-3) for x in sums)
 
 
 def test_bad_section_modes_are_refused_before_the_fem_runs() -> None:

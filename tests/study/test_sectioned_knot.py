@@ -46,11 +46,13 @@ def test_the_closed_trefoil_ties_at_the_sectioned_level(sectioned_run) -> None:
     assert s["crossing_calibrated_w_over_D0"] == cal.crossing_w_hat
     assert run.result.system.state.extra.size == scene.contact.dof_count > 0
     # the trefoil's strands touch on each other's bends, where the weights blending a
-    # partner's edges do not sum to one (measured 1.37 at the CLI's default vertex count,
-    # 1.41 at 100; docs/sectioned_level.md): the summary says so and by how much
-    assert s["contact_weight_sum_mean"] > 1.0 + WEIGHT_SUM_TOLERANCE
-    assert s["outside_calibrated_range"]
-    assert any("do not sum to one" in w for w in s["warnings"])
+    # partner's edges sum to one as on a straight partner (they telescope over its
+    # chords; the projection hats they replaced summed to 1.37 here on average,
+    # docs/sectioned_level.md); the summary reports the mean and has no warning of it
+    assert s["contact_weight_sum_mean"] == pytest.approx(1.0, abs=1e-3)
+    assert abs(s["contact_weight_sum_mean"] - 1.0) <= WEIGHT_SUM_TOLERANCE
+    assert not any("do not sum to one" in w for w in s["warnings"])
+    assert not s["outside_calibrated_range"]  # nothing else of this knot leaves it
 
 
 def test_a_sectioned_level_takes_no_radial_compliance_law() -> None:
@@ -226,6 +228,26 @@ def test_sections_thinner_than_the_fem_judged_are_said(sectioned_run) -> None:
                for w in out["warnings"])
 
 
+def test_contacts_whose_weights_stray_from_one_are_said(sectioned_run) -> None:
+    """The partition weights telescope to one on any partner (the tied trefoil: 1.000);
+    where a summary's mean strays by more than WEIGHT_SUM_TOLERANCE (contacts on the inside
+    of a partner bent tighter than the partition is exact for, rho kappa above about 0.7,
+    or many inside an exclusion ramp), it says so and marks the run outside its
+    calibrated range."""
+    scene, run = sectioned_run
+    st = run.result.system.state
+    rest = run.result.system.rest
+    rep = contact_report(scene.contact, st.x, rest, st)
+    ok = calibration_range(scene, rep, st.x, rest)
+    assert not any("sum to one" in w for w in ok["warnings"])
+    for mean in (1.0 + 1.5 * WEIGHT_SUM_TOLERANCE, 1.0 - 1.5 * WEIGHT_SUM_TOLERANCE):
+        out = calibration_range(scene, dataclasses.replace(rep, weight_sum_mean=mean), st.x,
+                                rest)
+        assert out["outside_calibrated_range"]
+        assert any(f"weigh {mean:.3g} times" in w and "sum to one" in w
+                   for w in out["warnings"])
+
+
 def _lost_solve(real, system, newton_options):
     """A failed solve that ends far from its start, as a leap into another basin leaves
     it: one Newton iteration from the start scaled by 1.01, reported unconverged."""
@@ -351,7 +373,12 @@ def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch,
     assert seen[0] == 1.0
     assert seen[1:] == ([0.125] if homotopy_fails else list(tie_module.PENALTY_HOMOTOPY))
     assert scene.contact.penalty_scale == 1.0
-    # the same knot: a closed knot's equilibria along its slide differ by ~1e-4 D0 in
-    # stretch (this file's final-versus-full test); its length to 1e-4
+    # the same knot, up to which of the shallow minima along its slide along the rod (a
+    # near-zero mode, this file's final-versus-full test) each path stops in: the
+    # homotopy's and the direct solve's ends of this 40-vertex knot are neighbouring
+    # minima (measured 1.07e-4 apart in length, 3.8e-6 in energy, at residual 1e-6 and
+    # 1e-8 alike), the proximal steps' the direct solve's own (1e-7 in length)
     assert _closed_length(res.system.state.x) == pytest.approx(
-        _closed_length(ref.system.state.x), rel=1e-4)
+        _closed_length(ref.system.state.x), rel=2e-4)
+    assert res.system.last_split.total == pytest.approx(ref.system.last_split.total,
+                                                        rel=1e-5)

@@ -31,9 +31,10 @@ class ContactReport:
         area_ratio: section area A/A0 from stretch and squeeze (incompressible) [-].
         pairs: contact point pairs (i, j) as vertex indices with their overlap [m].
         weight_sum_mean: the sectioned level's mean sum of a contact sample's passes'
-            weights (one along straight partners; docs/sectioned_level.md, "The partner's
-            partition of unity on a bent partner"); None at the other levels and without
-            contact.
+            weights (one but inside a rod's exclusion ramp, past an open end or on the
+            inside of a partner bent tighter than rho kappa about 0.7;
+            docs/sectioned_level.md, "The partner's partition of unity on a bent
+            partner"); None at the other levels and without contact.
     """
 
     overlap: np.ndarray

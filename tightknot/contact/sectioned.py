@@ -342,10 +342,23 @@ class SectionedLayer(ContactLayer):
         dev = self.device
         f64 = wp.float64
         ends = np.zeros((m.edge_count, 2), dtype=np.int32)
+        # each edge's neighbouring vertices on its rod, before its first and after its
+        # second (its partition weight's chords); -1 at an open end
+        neighbour = np.full((m.edge_count, 2), -1, dtype=np.int64)
         for rod in m.rods:
+            sl = rod.edge_slice
+            n_e = sl.stop - sl.start
             if not rod.closed:
-                ends[rod.edge_slice.start, 0] = 1
-                ends[rod.edge_slice.stop - 1, 1] = 1
+                ends[sl.start, 0] = 1
+                ends[sl.stop - 1, 1] = 1
+            for j in range(n_e):
+                e = sl.start + j
+                if j > 0 or rod.closed:
+                    neighbour[e, 0] = ev[sl.start + (j - 1) % n_e, 0]
+                if j < n_e - 1 or rod.closed:
+                    neighbour[e, 1] = ev[sl.start + (j + 1) % n_e, 1]
+        #: The vertex before and after each edge on its rod (-1 at an open end).
+        self.edge_neighbour = neighbour
         g_xi, g_w = self.settings.gauss
         samples = int(self.section.samples)
         sample_cos = wp.zeros(samples, dtype=f64, device=dev)
@@ -365,7 +378,7 @@ class SectionedLayer(ContactLayer):
             self.broad_phase.edge_exclusion,
             wp.array(g_xi, dtype=f64, device=dev), wp.array(g_w, dtype=f64, device=dev),
             sample_cos, sample_sin, k, samples, float(self.penalty), float(self.section.onset),
-            rod_mean, 0,
+            rod_mean, 0, wp.array(neighbour.astype(np.int32), dtype=wp.vec2i, device=dev),
         ]
         assert self._model_args[_PENALTY_ARG] == float(self.penalty)
         assert self._model_args[_GAUSS_NEWTON_ARG] == 0
@@ -544,11 +557,34 @@ class SectionedLayer(ContactLayer):
         return energy, grad, coo
 
     # -- contact between deformed boundaries ---------------------------------------------
-    def _margins(self, x: np.ndarray, extra: np.ndarray, rest: np.ndarray) -> np.ndarray:
+    def _partition_reach(self, x: np.ndarray, radius: np.ndarray) -> np.ndarray:
+        """How far [m] past its vertices each edge's partition weight reaches along its axis
+        within ``radius`` [m] of it (the kernels' ``reach_range``): half an edge on a
+        straight rod, more on the outside of a bend. A chord at more than 78 degrees to
+        its edge (a vertex turning by more than about 157 degrees, a rod folded through
+        itself) is taken at 78 degrees."""
+        ev = self._ev
+        e = x[ev[:, 1]] - x[ev[:, 0]]
+        length = np.linalg.norm(e, axis=1)
+        t = e / length[:, None]
+        nb = self.edge_neighbour
+        prev = np.where(nb[:, :1] >= 0, x[np.maximum(nb[:, 0], 0)], 2.0 * x[ev[:, 0]] - x[ev[:, 1]])
+        nxt = np.where(nb[:, 1:] >= 0, x[np.maximum(nb[:, 1], 0)], 2.0 * x[ev[:, 1]] - x[ev[:, 0]])
+        out = np.zeros(e.shape[0])
+        for c in (x[ev[:, 1]] - prev, nxt - x[ev[:, 0]]):
+            norm = np.linalg.norm(c, axis=1)
+            along = np.maximum(np.einsum("ij,ij->i", t, c), 0.2 * norm)
+            across = np.linalg.norm(np.cross(c, t), axis=1)
+            out = np.maximum(out, (0.25 * norm**2 + radius * across) / along)
+        return out
+
+    def _margins(self, x: np.ndarray, extra: np.ndarray, rest: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
         """Each edge's reach [m]: its largest boundary radius (the rest radius grown by 10 %
         for compression, plus 1.5 times its vertices' mode amplitudes, sum_n sqrt(a_n^2 +
-        b_n^2), each) and half its length (a partner's surface extends half an edge past its
-        vertices)."""
+        b_n^2), each) and how far its partition weight reaches past its vertices within
+        that radius (:meth:`_partition_reach`: half its length on a straight rod); and that
+        last part alone [m]."""
         ev = self._ev
         length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
         lam = length / rest
@@ -561,17 +597,22 @@ class SectionedLayer(ContactLayer):
             pairs = extra.reshape(-1, k // 2, 2)
             vsum[~self.vertex_rigid] = np.sqrt(np.sum(pairs * pairs, axis=2)).sum(axis=1)
             reach += 1.5 * (vsum[ev[:, 0]] + vsum[ev[:, 1]])
-        return reach + 0.5 * length
+        past = self._partition_reach(x, reach)
+        return reach + past, past
 
     def _candidates(self, x: np.ndarray, extra: np.ndarray, rest: np.ndarray
                     ) -> tuple[wp.array, wp.array, wp.array, wp.array]:
         broad = self.broad_phase
         wx = broad.x_in.put(x)
         arcs, rod_len = broad.arcs(rest)
-        margin = self._in_margin.put(self._margins(x, extra, rest))
-        # A sample's projection reaches half a partner edge past its vertices: keep pairs
-        # whose edges lie up to that much inside the exclusion window.
-        reach = 0.5 * float(np.max(rest)) / float(np.min(self.exclusion))
+        margins, past = self._margins(x, extra, rest)
+        margin = self._in_margin.put(margins)
+        # A sample's projection reaches past a partner edge's vertices (half an edge on a
+        # straight rod): keep pairs whose edges lie up to that much (in rest arc) inside
+        # the exclusion window.
+        ev = self._ev
+        length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
+        reach = float(np.max(past * rest / length)) / float(np.min(self.exclusion))
         pairs = broad.candidates(wx, broad.zero_dx, margin, arcs, rod_len,
                                  window=max(0.0, self.settings.candidate_window - reach))
         return wx, pairs, arcs, rod_len
@@ -583,12 +624,12 @@ class SectionedLayer(ContactLayer):
         """Launch ``kernel`` over both passes of ``pairs`` with the state arrays ``data``
         (coefficients, frames, end twists, rest lengths, arcs, rod lengths); with
         ``derivatives``, the Hessian goes into ``block_count`` node-pair blocks, pair p's
-        16 at ``slots[p]`` (nodes a0, a1, b0, b1). On a CPU the pairs are split into
+        72 at ``slots[p]`` (36 per pass, :meth:`_pass_nodes`). On a CPU the pairs are split into
         :func:`pair_chunks`, launched on as many threads."""
         dev = self.device
         f64 = wp.float64
         threads = 2 * pairs.shape[0]
-        nl = 12 + 4 * self.section.coeff_count
+        nl = 18 + 4 * self.section.coeff_count
         ng = len(self.settings.gauss[0])
         ns = ng * self.section.samples if report else 0
         with_lam = derivatives and self.rod_mean is not None
@@ -633,7 +674,7 @@ class SectionedLayer(ContactLayer):
 
             wp.launch(kernel, 2 * (hi - lo),
                       [*self._model_args, wx, *data, self._vertex_amp, self._edge_rbase,
-                       part(buf, 1), part(w_slots, 16, derivatives)],
+                       part(buf, 1), part(w_slots, 72, derivatives)],
                       [part(energy, 2), part(grad, 2 * nl, derivatives), blocks[i],
                        part(s_pen, 2 * ns, report), part(s_wt, 2 * ns, report),
                        part(dlam, 4, with_lam), part(tcol, 4 * nl, derivatives)],
@@ -755,19 +796,30 @@ class SectionedLayer(ContactLayer):
                 np.add.at(hess.blocks[:, :3, :3], slot,
                           blk[:, 3 * r:3 * r + 3, 3 * c:3 * c + 3])
 
+    def _pass_nodes(self, pairs: np.ndarray) -> np.ndarray:
+        """The vertices of each pass (2 P, 6): A's two, B's two, and B's neighbours on its
+        rod (-1 at an open end); pass 2p takes (a, b), pass 2p + 1 takes (b, a)."""
+        ev = self._ev
+        order = np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)  # (2P, 2): A, B
+        return np.concatenate([ev[order[:, 0]], ev[order[:, 1]],
+                               self.edge_neighbour[order[:, 1]]], axis=1)
+
     def _pass_dofs(self, pairs: np.ndarray) -> np.ndarray:
         """Extended dofs (model dofs, then model.dof_count + the term's) of each pass's
         local dofs (2 P, L): pass 2p takes (a, b), pass 2p + 1 takes (b, a); -1 for the
-        coefficients of a rigid section."""
+        coefficients of a rigid section and for a neighbour past an open end."""
         m = self.model
         k = self.section.coeff_count
-        ev = self._ev
-        order = np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)  # (2P, 2): A, B
-        verts = np.concatenate([ev[order[:, 0]], ev[order[:, 1]]], axis=1)  # (2P, 4)
-        pos = (m.vertex_dof.astype(np.int64)[verts][:, :, None] + np.arange(3)).reshape(-1, 12)
+        nodes = self._pass_nodes(pairs)
+        verts = nodes[:, :4]
+        vdof = m.vertex_dof.astype(np.int64)
+        pos = (vdof[verts][:, :, None] + np.arange(3)).reshape(-1, 12)
         off = self.vertex_offset[verts]  # (2P, 4)
         sec = np.where(off[:, :, None] >= 0, m.dof_count + off[:, :, None] + np.arange(k), -1)
-        return np.concatenate([pos, sec.reshape(-1, 4 * k)], axis=1)
+        nb = nodes[:, 4:]
+        near = np.where(nb[:, :, None] >= 0, vdof[np.maximum(nb, 0)][:, :, None] + np.arange(3),
+                        -1).reshape(-1, 6)
+        return np.concatenate([pos, sec.reshape(-1, 4 * k), near], axis=1)
 
     def contact_energy(self, x: np.ndarray, extra: np.ndarray,
                        frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray,
@@ -836,14 +888,16 @@ class SectionedLayer(ContactLayer):
         wp_act = wp.array(act_pairs.astype(np.int32), dtype=wp.vec2i, device=self.device)
         slots, keys = None, None
         if want_hess:
-            ev = self._ev
-            nodes = np.concatenate([ev[act_pairs[:, 0]], ev[act_pairs[:, 1]]], axis=1)  # (A, 4)
+            nodes = self._pass_nodes(act_pairs)  # (2A, 6)
+            # a neighbour past an open end has no rows (the kernel folds it onto B's
+            # vertices): its slots name B's first vertex's blocks, which the pass has
+            nodes[:, 4:] = np.where(nodes[:, 4:] >= 0, nodes[:, 4:], nodes[:, 2:3])
             pair_keys = (nodes[:, :, None] * m.vertex_count + nodes[:, None, :]).reshape(-1)
             keys, inverse = np.unique(np.concatenate([self._section_keys, pair_keys]),
                                       return_inverse=True)
-            slots = inverse[self._section_keys.size:].reshape(-1, 16)
+            slots = inverse[self._section_keys.size:].reshape(-1, 72)
         else:  # a gradient only: the kernel's Hessian goes to one discarded block
-            slots = np.zeros((act_pairs.shape[0], 16), dtype=np.int64)
+            slots = np.zeros((act_pairs.shape[0], 72), dtype=np.int64)
         out = self._launch(sk.DERIVATIVES, wx, wp_act, data, derivatives=True, slots=slots,
                            block_count=1 if keys is None else keys.size)
         if energy is None:
@@ -904,7 +958,7 @@ class SectionedLayer(ContactLayer):
         section_twist`) from the derivative kernel's outputs ``out`` over the passes of
         ``act_pairs`` (their extended dofs ``dofs``, :meth:`_pass_dofs`)."""
         k = self.section.coeff_count
-        nl = 12 + 4 * k
+        nl = 18 + 4 * k
         ev = self._ev
         order = np.stack([act_pairs, act_pairs[:, ::-1]], axis=1).reshape(-1, 2)  # A, B
         full = self.vertex_sections(extra)
@@ -1013,9 +1067,10 @@ class SectionedLayer(ContactLayer):
                     frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
         """At every sample in contact (arguments as :meth:`sample_passes`): the sum of
-        its passes' weights, one along a straight
-        partner and not along a bent one (docs/sectioned_level.md, "The partner's
-        partition of unity on a bent partner"), and its weighted penetration [m]."""
+        its passes' weights, one but inside a rod's exclusion ramp, past an open end or on
+        the inside of a partner bent tighter than rho kappa about 0.7
+        (docs/sectioned_level.md, "The partner's partition of unity on a bent partner"),
+        and its weighted penetration [m]."""
         owner, _, pen, weight = self.sample_passes(x, extra, frames, rest)
         sums, pens = _per_sample(owner, pen, weight, self.model.edge_count)
         touch = pens > 0.0

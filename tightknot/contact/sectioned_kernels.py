@@ -5,22 +5,26 @@ oracle :mod:`tightknot.contact.sectioned_reference` (its module docstring). One 
 evaluates one pass of one candidate pair: the boundary samples of its first edge A against
 the surface of its second edge B (thread 2 p: A = a, B = b; thread 2 p + 1: A = b, B = a).
 Each thread writes its energy and its gradient over the pass's local dofs (x_A0, x_A1,
-x_B0, x_B1, then the section coefficients of A's two vertices and of B's; L = 12 + 4 K for
-K coefficients per vertex) into its own slice of the outputs, and adds its Hessian into the
-dense blocks of the node pairs it couples (a node: a vertex with its 3 coordinates and K
-coefficients; the blocks' slots come with the pairs), which :mod:`tightknot.contact.
-sectioned` hands to the rod system.
+x_B0, x_B1, then the section coefficients of A's two vertices and of B's, then the
+vertices before and after B on its rod, x_Bprev and x_Bnext, which B's partition weight
+depends on; L = 18 + 4 K for K coefficients per vertex) into its own slice of the outputs,
+and adds its Hessian into the dense blocks of the node pairs it couples (a node: a vertex
+with its 3 coordinates and K coefficients; the blocks' slots come with the pairs, 36 per
+pass), which :mod:`tightknot.contact.sectioned` hands to the rod system.
 
 Per sample, every derivative over the L dofs is a combination of 16 reduced directions: the
 12 vertex coordinates and, for the sections, A's boundary at the sample's angle (along
 B(phi) + dR/dc, carried to A's two vertices by the interpolation weights), B's boundary at
 the angle psi facing the sample, its slope in psi, and the derivative of B's interpolation
-weights in the projection v. The per-sample Hessian is formed in those 16 directions,
+weights in the projection v; and the 6 components of B's neighbour chords' offsets f0 =
+x_B0 - x_Bprev, f1 = x_Bnext - x_B1, on which only the weight depends (a ghost at an open
+end, f = x_B1 - x_B0, folded onto B's own vertices). The per-sample Hessian is formed in
+those directions,
 carried to the pass's dofs (the mean radii's second derivatives in the coefficients, and
 mixed in the stretch and v, added there) and summed over the pass's samples in registers,
-one block per pair of its nodes (the coordinates' 12 x 12, the coordinates against each vertex's
-coefficients, the coefficients' K x K blocks), which are added into the node-pair blocks
-once per pass.
+one block per pair of its nodes (the coordinates' 18 x 18, the coordinates against each
+vertex's coefficients, the coefficients' K x K blocks), which are added into the node-pair
+blocks once per pass.
 
 With ``gauss_newton`` set (:meth:`tightknot.contact.sectioned.SectionedLayer.
 set_gauss_newton`), a sample's Hessian is its Gauss-Newton part alone, a_s wt phi''(pen)
@@ -29,8 +33,10 @@ derivatives (the gap's own curvature, the mean radii's second derivatives, P's s
 derivatives in A's edge vector) is left out; energy and gradient are unchanged.
 
 Work is skipped where no contact can be: a pass whose edges lie farther apart than the
-two sections' largest radii, a Gauss circle of A whose axis point is farther from B's axis
-than those radii, and a sample farther from B's axis than B's largest radius (the bounds:
+two sections' largest radii (B's axis taken over the reach of its weight,
+:func:`reach_range`), a Gauss circle of A whose axis point is farther from it than those
+radii, a sample outside the planes that bound B's weight, and a sample farther from B's
+axis than B's largest radius (the bounds:
 the mean radius at the edge's stretch and the coefficients' amplitude sums, which bound
 every boundary radius; computed once per state by :func:`section_bounds`). A sample is
 first tested at its mean radius, with A's amplitude sum as margin, so that the samples
@@ -56,6 +62,9 @@ mat66d = wp.types.matrix(shape=(6, 6), dtype=wp.float64)
 mat36d = wp.types.matrix(shape=(3, 6), dtype=wp.float64)
 mat6x16d = wp.types.matrix(shape=(6, 16), dtype=wp.float64)
 mat12d = wp.types.matrix(shape=(12, 12), dtype=wp.float64)
+vec12d = wp.types.vector(length=12, dtype=wp.float64)
+mat18d = wp.types.matrix(shape=(18, 18), dtype=wp.float64)
+mat18xKd = wp.types.matrix(shape=(18, MAX_COEFF), dtype=wp.float64)
 mat12xKd = wp.types.matrix(shape=(12, MAX_COEFF), dtype=wp.float64)
 matKd = wp.types.matrix(shape=(MAX_COEFF, MAX_COEFF), dtype=wp.float64)
 mat6xKd = wp.types.matrix(shape=(6, MAX_COEFF), dtype=wp.float64)
@@ -97,25 +106,6 @@ def quintic(x: wp.float64) -> wp.vec3d:
     return wp.vec3d(x2 * x * (f64(10.0) - f64(15.0) * x + f64(6.0) * x2),
                     f64(30.0) * x2 * (f64(1.0) - x) * (f64(1.0) - x),
                     f64(60.0) * x * (f64(1.0) - x) * (f64(1.0) - f64(2.0) * x))
-
-
-@wp.func
-def partition_weight(v: wp.float64, first_open: int, last_open: int) -> wp.vec3d:
-    """omega(v), omega', omega'' (sectioned_reference.partition_weight)."""
-    if first_open != 0:
-        if v < f64(0.0):
-            s = quintic(f64(2.0) * v + f64(1.0))
-            return wp.vec3d(s[0], f64(2.0) * s[1], f64(4.0) * s[2])
-    elif v < f64(0.5):
-        return quintic(v + f64(0.5))
-    if last_open != 0:
-        if v > f64(1.0):
-            s = quintic(f64(2.0) * v - f64(2.0))
-            return wp.vec3d(f64(1.0) - s[0], f64(-2.0) * s[1], f64(-4.0) * s[2])
-    elif v > f64(0.5):
-        s = quintic(v - f64(0.5))
-        return wp.vec3d(f64(1.0) - s[0], -s[1], -s[2])
-    return wp.vec3d(f64(1.0), f64(0.0), f64(0.0))
 
 
 @wp.func
@@ -240,14 +230,14 @@ def amplitude_sum(c: vecKd, k: int) -> wp.float64:
 
 
 @wp.func
-def segment_line_distance(p0: wp.vec3d, p1: wp.vec3d, q0: wp.vec3d, e: wp.vec3d
-                          ) -> wp.float64:
+def segment_line_distance(p0: wp.vec3d, p1: wp.vec3d, q0: wp.vec3d, e: wp.vec3d,
+                          v_lo: wp.float64, v_hi: wp.float64) -> wp.float64:
     """A lower bound of the distance [m] from segment p0 p1 to the segment q0 + v e,
-    v in [-1/2, 3/2] (the reach of a partner edge's partition weight): the distance of
-    their closest points (Ericson 2005 sec. 5.1.9, clamped)."""
+    v in [v_lo, v_hi] (the reach of a partner edge's partition weight, :func:`reach_range`):
+    the distance of their closest points (Ericson 2005 sec. 5.1.9, clamped)."""
     d1 = p1 - p0
-    r = p0 - (q0 - f64(0.5) * e)
-    d2 = f64(2.0) * e
+    r = p0 - (q0 + v_lo * e)
+    d2 = (v_hi - v_lo) * e
     a = wp.dot(d1, d1)
     ee = wp.dot(d2, d2)
     f = wp.dot(d2, r)
@@ -264,7 +254,165 @@ def segment_line_distance(p0: wp.vec3d, p1: wp.vec3d, q0: wp.vec3d, e: wp.vec3d
     elif t > f64(1.0):
         t = f64(1.0)
         s = wp.clamp((b - c) / a, f64(0.0), f64(1.0))
-    return wp.length(p0 + s * d1 - (q0 - f64(0.5) * e + t * d2))
+    return wp.length(p0 + s * d1 - (q0 + v_lo * e + t * d2))
+
+
+@wp.func
+def reach_range(e: wp.vec3d, c0: wp.vec3d, c1: wp.vec3d, radius: wp.float64) -> wp.vec2d:
+    """The range [v_lo, v_hi] of the projection v on an edge's axis (vector ``e`` [m])
+    of every point within ``radius`` [m] of the axis where the edge's partition weight is
+    not zero (between the planes s0 = -1/2 and s1 = 1/2 of its chords ``c0``, ``c1``,
+    :func:`partition_terms`): on the plane (P - x0) . c0 = -|c0|^2 / 4 a point at
+    distance rho from the axis has v (e . c0) >= -|c0|^2 / 4 - rho |c0 x t|. Unbounded
+    (+-1e30) where a chord makes a right angle or more with the edge."""
+    ll = wp.length(e)
+    t = e / ll
+    v_lo = f64(-1.0e30)
+    v_hi = f64(1.0e30)
+    ec0 = wp.dot(e, c0)
+    if ec0 > f64(0.0):
+        v_lo = -(f64(0.25) * wp.dot(c0, c0) + radius * wp.length(wp.cross(c0, t))) / ec0
+    ec1 = wp.dot(e, c1)
+    if ec1 > f64(0.0):
+        v_hi = f64(1.0) + (f64(0.25) * wp.dot(c1, c1) + radius * wp.length(wp.cross(c1, t))) / ec1
+    return wp.vec2d(v_lo, v_hi)
+
+
+@wp.func
+def chord_coordinate(y: wp.vec3d, c: wp.vec3d):
+    """s = 2 y . c / (c . c) of a point at y from a vertex whose chord is c, with ds/dy,
+    ds/dc and the second derivatives d2s/dy dc, d2s/dc2 (d2s/dy2 = 0)
+    (sectioned_reference.partition)."""
+    dd = wp.dot(c, c)
+    yc = wp.dot(y, c)
+    eye = wp.identity(n=3, dtype=wp.float64)
+    gy = (f64(2.0) / dd) * c
+    gc = (f64(2.0) / dd) * y - (f64(4.0) * yc / (dd * dd)) * c
+    hyc = (f64(2.0) / dd) * eye - (f64(4.0) / (dd * dd)) * wp.outer(c, c)
+    hcc = ((f64(-4.0) / (dd * dd)) * (wp.outer(y, c) + wp.outer(c, y))
+           - (f64(4.0) * yc / (dd * dd)) * eye
+           + (f64(16.0) * yc / (dd * dd * dd)) * wp.outer(c, c))
+    return f64(2.0) * yc / dd, gy, gc, hyc, hcc
+
+
+@wp.func
+def side_step(s: wp.float64, is_open: int, low: int) -> wp.vec3d:
+    """sigma(s) and its first two derivatives at one vertex of an edge: S(s + 1/2) at a
+    vertex shared with the next edge, S(2 s + 1) at the start and S(2 s) at the end of an
+    open rod (``low``: the edge's first vertex)."""
+    scale = f64(1.0)
+    shift = f64(0.5)
+    if is_open != 0:
+        scale = f64(2.0)
+        shift = f64(0.0)
+        if low != 0:
+            shift = f64(1.0)
+    q = quintic(scale * s + shift)
+    return wp.vec3d(q[0], scale * q[1], scale * scale * q[2])
+
+
+@wp.func
+def partition_value(w: wp.vec3d, e: wp.vec3d, c0: wp.vec3d, c1: wp.vec3d, first_open: int,
+                    last_open: int) -> wp.float64:
+    """The partner edge's partition weight omega at w = P - x_B0 (:func:`partition_terms`
+    without derivatives)."""
+    s0 = f64(2.0) * wp.dot(w, c0) / wp.dot(c0, c0)
+    s1 = f64(2.0) * wp.dot(w - e, c1) / wp.dot(c1, c1)
+    om = side_step(s0, first_open, 1)[0] - side_step(s1, last_open, 0)[0]
+    return wp.max(om, f64(0.0))
+
+
+@wp.func
+def add_block12(h: mat12d, bi: int, bj: int, m: wp.mat33d) -> mat12d:
+    """h with m added at block (bi, bj) (blocks of 3)."""
+    for i in range(3):
+        for j in range(3):
+            h[3 * bi + i, 3 * bj + j] = h[3 * bi + i, 3 * bj + j] + m[i, j]
+    return h
+
+
+@wp.func
+def put3(g: vec12d, b: int, v: wp.vec3d, scale: wp.float64) -> vec12d:
+    """g with scale v added at block b (blocks of 3)."""
+    for i in range(3):
+        g[3 * b + i] = g[3 * b + i] + scale * v[i]
+    return g
+
+
+@wp.func
+def fold_ghost(g: vec12d, h: mat12d, src: int):
+    """A ghost neighbour's chord offset f = e (block ``src``) folded onto e (block 1):
+    g_e += g_f, H's rows and columns likewise, block ``src`` zeroed."""
+    for i in range(3):
+        g[3 + i] = g[3 + i] + g[3 * src + i]
+        g[3 * src + i] = f64(0.0)
+    for i in range(3):
+        for j in range(12):
+            h[3 + i, j] = h[3 + i, j] + h[3 * src + i, j]
+    for i in range(12):
+        for j in range(3):
+            h[i, 3 + j] = h[i, 3 + j] + h[i, 3 * src + j]
+    for i in range(3):
+        for j in range(12):
+            h[3 * src + i, j] = f64(0.0)
+            h[j, 3 * src + i] = f64(0.0)
+    return g, h
+
+
+@wp.func
+def partition_terms(w: wp.vec3d, e: wp.vec3d, f0: wp.vec3d, f1: wp.vec3d, ghost0: int,
+                    ghost1: int, first_open: int, last_open: int):
+    """The partner edge's partition weight omega = sigma0(s0) - sigma1(s1) (clamped at 0)
+    with its gradient and Hessian over (w, e, f0, f1) = (P - x_B0, x_B1 - x_B0, x_B0 -
+    x_Bprev, x_Bnext - x_B1) (sectioned_reference.partition): s0 = 2 w . c0 / |c0|^2 with
+    the chord c0 = e + f0, s1 = 2 (w - e) . c1 / |c1|^2 with c1 = e + f1. A ghost
+    neighbour (an open end: f = e) has its block folded onto e."""
+    g = vec12d()
+    h = mat12d()
+    c0 = e + f0
+    c1 = e + f1
+    s0, gy0, gc0, hyc0, hcc0 = chord_coordinate(w, c0)
+    s1, gy1, gc1, hyc1, hcc1 = chord_coordinate(w - e, c1)
+    q0 = side_step(s0, first_open, 1)
+    q1 = side_step(s1, last_open, 0)
+    om = q0[0] - q1[0]
+    if om <= f64(0.0):
+        return f64(0.0), g, h
+    # ds/d(w, e, f0, f1): s0 through y = w, c = e + f0; s1 through y = w - e, c = e + f1
+    g0 = vec12d()
+    g0 = put3(g0, 0, gy0, f64(1.0))
+    g0 = put3(g0, 1, gc0, f64(1.0))
+    g0 = put3(g0, 2, gc0, f64(1.0))
+    g1 = vec12d()
+    g1 = put3(g1, 0, gy1, f64(1.0))
+    g1 = put3(g1, 1, gc1 - gy1, f64(1.0))
+    g1 = put3(g1, 3, gc1, f64(1.0))
+    g = q0[1] * g0 - q1[1] * g1
+    h = q0[2] * wp.outer(g0, g0) - q1[2] * wp.outer(g1, g1)
+    # sigma' times the chord coordinates' own second derivatives (hyc, hcc symmetric)
+    a0 = q0[1]
+    h = add_block12(h, 0, 1, a0 * hyc0)
+    h = add_block12(h, 1, 0, a0 * hyc0)
+    h = add_block12(h, 0, 2, a0 * hyc0)
+    h = add_block12(h, 2, 0, a0 * hyc0)
+    h = add_block12(h, 1, 1, a0 * hcc0)
+    h = add_block12(h, 1, 2, a0 * hcc0)
+    h = add_block12(h, 2, 1, a0 * hcc0)
+    h = add_block12(h, 2, 2, a0 * hcc0)
+    a1 = -q1[1]
+    h = add_block12(h, 0, 1, a1 * hyc1)
+    h = add_block12(h, 1, 0, a1 * hyc1)
+    h = add_block12(h, 0, 3, a1 * hyc1)
+    h = add_block12(h, 3, 0, a1 * hyc1)
+    h = add_block12(h, 1, 1, a1 * (hcc1 - f64(2.0) * hyc1))
+    h = add_block12(h, 1, 3, a1 * (hcc1 - hyc1))
+    h = add_block12(h, 3, 1, a1 * (hcc1 - hyc1))
+    h = add_block12(h, 3, 3, a1 * hcc1)
+    if ghost0 != 0:
+        g, h = fold_ghost(g, h, 2)
+    if ghost1 != 0:
+        g, h = fold_ghost(g, h, 3)
+    return om, g, h
 
 
 @wp.struct
@@ -550,21 +698,44 @@ def turn_direction(c: vecKd, k: int) -> vecKd:
 
 
 @wp.func
+def chord_target(i: int, side: int):
+    """The coordinate (of the pass's 18: x_A0, x_A1, x_B0, x_B1, x_Bprev, x_Bnext) and sign
+    of one of the two vertices that chord offset component ``i`` depends on: f0 = x_B0 -
+    x_Bprev (i < 3), f1 = x_Bnext - x_B1 (i >= 3)."""
+    if i < 3:
+        if side == 0:
+            return 6 + i, f64(1.0)
+        return 12 + i, f64(-1.0)
+    if side == 0:
+        return 12 + i, f64(1.0)
+    return 6 + i, f64(-1.0)
+
+
+@wp.func
+def local_coordinate(i: int, k: int) -> int:
+    """The pass's local dof of its coordinate i (of 18): the neighbours' come after the
+    sections' 4 k coefficients."""
+    if i < 12:
+        return i
+    return 4 * k + i
+
+
+@wp.func
 def twist_column(out: wp.array(dtype=wp.float64), to: int, grad: wp.array(dtype=wp.float64),
-                 g_at: int, v: vecKd, k: int, node: int, h_x: mat12xKd, h_0: matKd,
+                 g_at: int, v: vecKd, k: int, node: int, h_x: mat18xKd, h_0: matKd,
                  h_1: matKd, h_2: matKd, h_3: matKd):
     """Write H[y, c] v over the pass's local dofs y, c the coefficients of local node
     ``node`` (1: A's second vertex, 3: B's), v = n J c (:func:`turn_direction`), plus
     (n J)^T grad_c (the gradient at ``grad[g_at:]``) on c's rows. ``h_x``: the coordinates
-    against c (12 x k); ``h_0`` .. ``h_3``: the coefficient blocks of the four nodes
+    against c (18 x k); ``h_0`` .. ``h_3``: the coefficient blocks of the four nodes
     against c's node as the pass holds them: for node 1, (A0, A1) [A0 row], (A1, A1)
     upper, (A1, B0) and (A1, B1) [A1 row]; for node 3, (A0, B1), (A1, B1), (B0, B1)
     [B1 column] and (B1, B1) upper."""
-    for i in range(12):
+    for i in range(18):
         s = f64(0.0)
         for j in range(k):
             s += h_x[i, j] * v[j]
-        out[to + i] = s
+        out[to + local_coordinate(i, k)] = s
     for i in range(k):
         s0 = f64(0.0)
         s1 = f64(0.0)
@@ -692,6 +863,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
         onset: wp.float64,
         rod_mean: int,
         gauss_newton: int,
+        edge_neighbour: wp.array(dtype=wp.vec2i),
         # Data in:
         x_in: wp.array(dtype=wp.vec3d),
         coeff_in: wp.array(dtype=wp.float64),
@@ -723,7 +895,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             ea = pr[1]
             eb = pr[0]
         k = coeff_count
-        nl = 12 + 4 * k
+        nl = 18 + 4 * k
         ng = gauss_xi.shape[0]
         # 1 for the exact Hessian, 0 for its Gauss-Newton part (a_s wt phi'' grad(pen)
         # grad(pen)^T per sample, positive semidefinite)
@@ -767,7 +939,26 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             amp_a = f64(0.0)
         if rig_b != 0:
             r_b_max = edge_r0[eb]
-        if segment_line_distance(xa0, x_in[va[1]], xb0, vec_b) > r_a_max + r_b_max:
+        # B's chords at its vertices (its rod's neighbours; a ghost at an open end, f = e)
+        # and the reach of its partition weight along its axis
+        nb = edge_neighbour[eb]
+        ghost0 = int(1)
+        ghost1 = int(1)
+        f0 = vec_b
+        f1 = vec_b
+        if nb[0] >= 0:
+            f0 = xb0 - x_in[nb[0]]
+            ghost0 = 0
+        if nb[1] >= 0:
+            f1 = x_in[nb[1]] - x_in[vb[1]]
+            ghost1 = 0
+        ch0 = vec_b + f0
+        ch1 = vec_b + f1
+        ds0 = f64(2.0) / wp.length(ch0)  # |dP s0|: s0 moves by at most this per metre
+        ds1 = f64(2.0) / wp.length(ch1)
+        reach = reach_range(vec_b, ch0, ch1, r_b_max)
+        if segment_line_distance(xa0, x_in[va[1]], xb0, vec_b, reach[0],
+                                 reach[1]) > r_a_max + r_b_max:
             energy_out[tid] = energy
             return
         # The sections of the edges' vertices, the second one's turned into the edge's
@@ -819,11 +1010,11 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             # summed over its samples in registers: the coordinates' block, the
             # coordinates against each vertex's coefficients, and the coefficients' blocks
             # of the node pairs (the diagonal ones upper triangles only).
-            h_xx = mat12d()
-            h_xa0 = mat12xKd()
-            h_xa1 = mat12xKd()
-            h_xb0 = mat12xKd()
-            h_xb1 = mat12xKd()
+            h_xx = mat18d()
+            h_xa0 = mat18xKd()
+            h_xa1 = mat18xKd()
+            h_xb0 = mat18xKd()
+            h_xb1 = mat18xKd()
             h_a0a0 = matKd()
             h_a0a1 = matKd()
             h_a1a1 = matKd()
@@ -845,7 +1036,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
             # the Gauss circle cannot reach B
             rel0 = xu - xb0
             v0 = wp.dot(rel0, vec_b) / (lb * lb)
-            v0c = wp.clamp(v0, f64(-0.5), f64(1.5))
+            v0c = wp.clamp(v0, reach[0], reach[1])
             if wp.length(rel0 - v0c * vec_b) > r_a_max + r_b_max:
                 continue
             ca = (f64(1.0) - u) * ca0 + u * ca1
@@ -868,7 +1059,9 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     slack = amp_a * f64(1.000001) + f64(1.0e-9) * (r_a_max + r_b_max)
                     relq = xu + ra_mean * dirv - xb0
                     vq = wp.dot(relq, vec_b) / (lb * lb)
-                    if vq < f64(-0.5) - slack / lb or vq > f64(1.5) + slack / lb:
+                    s0q = f64(2.0) * wp.dot(relq, ch0) / wp.dot(ch0, ch0)
+                    s1q = f64(2.0) * wp.dot(relq - vec_b, ch1) / wp.dot(ch1, ch1)
+                    if s0q <= f64(-0.5) - slack * ds0 or s1q >= f64(0.5) + slack * ds1:
                         continue
                     if wp.length(relq - vq * vec_b) - slack >= r_b_max:
                         continue
@@ -879,7 +1072,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 p = xu + r_a * dirv
                 rel = p - xb0
                 v = wp.dot(rel, vec_b) / (lb * lb)
-                if v < f64(-0.5) or v > f64(1.5):
+                om = partition_value(rel, vec_b, ch0, ch1, endb[0], endb[1])
+                if om <= f64(0.0):
                     continue
                 dvec = rel - v * vec_b
                 rho = wp.length(dvec)
@@ -904,9 +1098,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         n2 = f64((2 + j) * (2 + j))
                         r_b2 -= n2 * (bpsi[2 * j] * cb[2 * j] + bpsi[2 * j + 1] * cb[2 * j + 1])
                 pen = r_b - rho
-                om = partition_weight(v, endb[0], endb[1])
                 wex = exclusion_weight(same_rod, closed, rod_len, s_a, arc_b, excl, v)
-                wt = om[0] * wex[0]
+                wt = om * wex[0]
                 if wp.static(report):
                     sample_pen_out[so + gi * samples + kk] = pen
                     sample_weight_out[so + gi * samples + kk] = wt
@@ -916,9 +1109,30 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 a_s = f64(0.5) * gauss_w[gi] * area
                 energy += a_s * wt * ph[0]
                 if wp.static(derivatives):
-                    wt1 = om[1] * wex[0] + om[0] * wex[1]
-                    wt2 = om[2] * wex[0] + f64(2.0) * om[1] * wex[1] + om[0] * wex[2]
                     cyl = cylinder(rel, vec_b, fb)
+                    # The weight wt = omega W(v) over (w, e, f0, f1): omega's derivatives
+                    # (partition_terms), W's through the projection v, whose own
+                    # curvature (hv) enters the (w, e) block below.
+                    _om, g_om, h_om = partition_terms(rel, vec_b, f0, f1, ghost0, ghost1,
+                                                       endb[0], endb[1])
+                    gv12 = vec12d()
+                    for i in range(6):
+                        gv12[i] = cyl.gv[i]
+                    gwt = wex[0] * g_om + (om * wex[1]) * gv12
+                    hwt = (wex[0] * h_om + wex[1] * (wp.outer(g_om, gv12) + wp.outer(gv12, g_om))
+                           + (om * wex[2]) * wp.outer(gv12, gv12))
+                    gwt6 = vec6d()
+                    gwtf = vec6d()
+                    hwt6 = mat66d()
+                    hwtf = mat66d()  # rows f, columns (w, e)
+                    hwff = mat66d()
+                    for i in range(6):
+                        gwt6[i] = gwt[i]
+                        gwtf[i] = gwt[6 + i]
+                        for j in range(6):
+                            hwt6[i, j] = hwt[i, j] + om * wex[1] * cyl.hv[i, j]
+                            hwtf[i, j] = hwt[6 + i, j]
+                            hwff[i, j] = hwt[6 + i, 6 + j]
                     # dr/dc at the sample on each side, and B's radius partials in (psi, v)
                     ba = bphi - ca / (f64(2.0) * ra_mean)
                     bb = bpsi - cb / (f64(2.0) * rb_mean)
@@ -961,9 +1175,9 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                         # direction d by dR_A/dlam, changing pen (dpen/dw = -g_we) and the
                         # partition's v (dv/dw = gv); B's radius grows by dR_B/dlam
                         dwa = wp.vec3d(g_we[0], g_we[1], g_we[2])
-                        dva = wp.vec3d(gv[0], gv[1], gv[2])
+                        dva = wp.vec3d(gwt6[0], gwt6[1], gwt6[2])
                         dlam_a += a_s * ra_l * (-wt * ph[1] * wp.dot(dwa, dirv)
-                                                + ph[0] * wt1 * wp.dot(dva, dirv))
+                                                + ph[0] * wp.dot(dva, dirv))
                         dlam_b += a_s * wt * ph[1] * rb_l
                     # The sample's gradient and Hessian over the 16 reduced directions:
                     # E = a_s wt phi(pen) with pen = r_B - rho, its 6-space part over
@@ -972,30 +1186,29 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     # and P's own second derivatives.
                     c_gg = a_s * wt * ph[2]
                     c_g = a_s * wt * ph[1]
-                    c_gv = a_s * ph[1] * wt1
-                    c_vv = a_s * ph[0] * wt2
-                    c_v = a_s * ph[0] * wt1
-                    # The Hessian's terms that carry the penalty's or the partition's
-                    # first derivative (the gap's and the weights' own curvature), which
-                    # the Gauss-Newton Hessian leaves out (curv = 0).
+                    c_gw = a_s * ph[1]  # on grad g grad wt^T
+                    c_w = a_s * ph[0]  # on grad wt and its Hessian
+                    # The Hessian's terms that carry the penalty's or the weight's first
+                    # derivative (the gap's and the weight's own curvature), which the
+                    # Gauss-Newton Hessian leaves out (curv = 0).
                     hc_g = curv * c_g
-                    hc_gv = curv * c_gv
-                    hc_vv = curv * c_vv
-                    hc_v = curv * c_v
-                    h6 = (c_gg * wp.outer(g_we, g_we) - hc_gv * (wp.outer(g_we, gv)
-                                                                 + wp.outer(gv, g_we))
-                          + hc_vv * wp.outer(gv, gv) - hc_g * h_we + hc_v * cyl.hv)
+                    hc_gw = curv * c_gw
+                    hc_w = curv * c_w
+                    h6 = (c_gg * wp.outer(g_we, g_we) - hc_gw * (wp.outer(g_we, gwt6)
+                                                                 + wp.outer(gwt6, g_we))
+                          + hc_w * hwt6 - hc_g * h_we)
                     h = reduce_mat(h6, dp_de, dirv, 1 - rig_a)
                     jg = reduce_vec(g_we, dp_de, dirv, 1 - rig_a)
                     jq = reduce_vec(gv, dp_de, dirv, 1 - rig_a)
-                    r_grad = -c_g * jg + c_v * jq
+                    jw = reduce_vec(gwt6, dp_de, dirv, 1 - rig_a)
+                    r_grad = -c_g * jg + c_w * jw
                     if rig_b == 0:
                         # pen's -1 in beta, and dpen/dgamma = -r_psi, dpen/ddelta = -r_v
                         # about the sample (r_psi = J^T grad psi, r_v = J^T grad v)
                         js = reduce_vec(gpsi, dp_de, dirv, 1 - rig_a)
                         r_grad[13] = c_g
                         for c in range(13):
-                            v13 = -c_gg * jg[c] + hc_gv * jq[c]
+                            v13 = -c_gg * jg[c] + hc_gw * jw[c]
                             h[c, 13] = h[c, 13] + v13
                             h[13, c] = h[13, c] + v13
                             h[c, 14] = h[c, 14] + hc_g * js[c]
@@ -1009,7 +1222,7 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                     hra = ((ra_llx / (rest_in[ea] * rest_in[ea])) * wp.outer(ta, ta)
                            + (ra_lx / (la * rest_in[ea])) * (eye - wp.outer(ta, ta)))
                     gw = (-hc_g * wp.vec3d(g_we[0], g_we[1], g_we[2])
-                          + hc_v * wp.vec3d(gv[0], gv[1], gv[2]))
+                          + hc_w * wp.vec3d(gwt6[0], gwt6[1], gwt6[2]))
                     row = wp.transpose(m_dir) @ gw
                     pee = (r_a * (cphi * contract(gw, fa.t1x, fa.t1y, fa.t1z)
                                   + sphi * contract(gw, fa.t2x, fa.t2y, fa.t2z))
@@ -1037,6 +1250,35 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                                 h_xx[i, j] = h_xx[i, j] + h[i, j]
                             else:
                                 h_xx[i, j] = h_xx[i, j] + h[j, i]
+                    # B's neighbour chords f0 = x_B0 - x_Bprev and f1 = x_Bnext - x_B1 (the
+                    # weight alone depends on them): their rows against the reduced
+                    # directions and among themselves, carried to the coordinates (rows
+                    # 12..14: x_Bprev, 15..17: x_Bnext) with f's signs (chord_target).
+                    for i in range(6):
+                        row6 = vec6d()
+                        for j in range(6):
+                            row6[j] = hc_w * hwtf[i, j] - hc_gw * gwtf[i] * g_we[j]
+                        fr = reduce_vec(row6, dp_de, dirv, 1 - rig_a)
+                        fb13 = hc_gw * gwtf[i]
+                        for side in range(2):
+                            tgt, sg = chord_target(i, side)
+                            grad_out[go + local_coordinate(tgt, k)] = (
+                                grad_out[go + local_coordinate(tgt, k)] + sg * c_w * gwtf[i])
+                            for c in range(12):
+                                h_xx[tgt, c] = h_xx[tgt, c] + sg * fr[c]
+                                h_xx[c, tgt] = h_xx[c, tgt] + sg * fr[c]
+                            for j in range(6):
+                                for side2 in range(2):
+                                    tgt2, sg2 = chord_target(j, side2)
+                                    h_xx[tgt, tgt2] = h_xx[tgt, tgt2] + sg * sg2 * hc_w * hwff[i, j]
+                            if rig_a == 0:
+                                for j in range(k):
+                                    h_xa0[tgt, j] = h_xa0[tgt, j] + sg * fr[12] * wa0[j]
+                                    h_xa1[tgt, j] = h_xa1[tgt, j] + sg * fr[12] * wa1[j]
+                            if rig_b == 0:
+                                for j in range(k):
+                                    h_xb0[tgt, j] = h_xb0[tgt, j] + sg * fb13 * x0[j]
+                                    h_xb1[tgt, j] = h_xb1[tgt, j] + sg * fb13 * x1[j]
                     if rig_a == 0:
                         for j in range(k):
                             grad_out[go + 12 + j] = grad_out[go + 12 + j] + r_grad[12] * wa0[j]
@@ -1200,8 +1442,8 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
                 pair = tid // 2
                 flip = tid % 2
                 bsz = 3 + k
-                for n in range(4):
-                    for m in range(4):
+                for n in range(6):
+                    for m in range(6):
                         base = _slot_base(slots_in, pair, flip, n, m, bsz)
                         for r in range(3):
                             for c in range(3):
@@ -1250,23 +1492,18 @@ def make_pass_kernel(derivatives: bool, report: bool) -> wp.Kernel:
 @wp.func
 def _slot_base(slots: wp.array(dtype=wp.int32), pair: int, flip: int, n: int, m: int,
                bsz: int) -> int:
-    """Offset of the node-pair block (pass nodes n, m: A0, A1, B0, B1) in the blocks: pair
-    p's 16 blocks are ``slots[16 p + 4 n + m]`` in its (a0, a1, b0, b1) order, and pass 1
-    has A = b (its node n is the pair's (n + 2) % 4)."""
-    nn = n
-    mm = m
-    if flip == 1:
-        nn = (n + 2) % 4
-        mm = (m + 2) % 4
-    return slots[pair * 16 + nn * 4 + mm] * bsz * bsz
+    """Offset of the node-pair block (pass nodes n, m: A0, A1, B0, B1, Bprev, Bnext) in the
+    blocks: pass ``flip`` of pair p has its 36 blocks at ``slots[72 p + 36 flip + 6 n +
+    m]`` (pass 1 takes A = b)."""
+    return slots[pair * 72 + flip * 36 + n * 6 + m] * bsz * bsz
 
 
 @wp.func
 def scatter_x_coeff(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp.int32),
-                    pair: int, flip: int, bsz: int, k: int, m: int, hx: mat12xKd):
-    """Add the coordinates' rows against node m's coefficients (``hx``, 12 x k) into the
-    node-pair blocks (n, m), and their transposes into (m, n), for the four nodes n."""
-    for n in range(4):
+                    pair: int, flip: int, bsz: int, k: int, m: int, hx: mat18xKd):
+    """Add the coordinates' rows against node m's coefficients (``hx``, 18 x k) into the
+    node-pair blocks (n, m), and their transposes into (m, n), for the six nodes n."""
+    for n in range(6):
         base = _slot_base(slots, pair, flip, n, m, bsz)
         base_t = _slot_base(slots, pair, flip, m, n, bsz)
         for r in range(3):
@@ -1278,8 +1515,8 @@ def scatter_x_coeff(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp
 
 @wp.func
 def scatter_side(blocks: wp.array(dtype=wp.float64), slots: wp.array(dtype=wp.int32),
-                 pair: int, flip: int, bsz: int, k: int, first: int, hx0: mat12xKd,
-                 hx1: mat12xKd, h00: matKd, h11: matKd, h01: matKd):
+                 pair: int, flip: int, bsz: int, k: int, first: int, hx0: mat18xKd,
+                 hx1: mat18xKd, h00: matKd, h11: matKd, h01: matKd):
     """Add one side's coefficient blocks (its vertices: nodes ``first`` and ``first`` + 1):
     against the coordinates (``hx0``, ``hx1``), its two diagonal blocks (upper triangles
     ``h00``, ``h11``) and the block between its vertices (``h01``)."""

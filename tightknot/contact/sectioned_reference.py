@@ -26,10 +26,27 @@ Gauss point u on its axis and angle phi in its frame, is
 
 its gap to b's surface is g = rho - r_b(v, psi), rho the distance of P to b's axis line, v
 the projection of P on that axis (v in [0, 1] on the edge) and psi the angle of P about it
-in b's frame (a radial gap of a star-shaped section). The sample is weighed by a smooth
-partition of unity omega(v) over b's edge and its neighbours (a quintic hat on
-[-1/2, 3/2]: the hats of two consecutive edges sum to one), so that the partner's surface
-passes from edge to edge without a jump where the axis bends. Pairs of one rod take the
+in b's frame (a radial gap of a star-shaped section). The sample is weighed by omega(P) of
+a partition of unity over b's rod (:func:`partition`), so that the partner's surface passes
+from edge to edge without a jump where the axis bends. It is built on the bisector planes
+of b's vertices: at b's vertex x_0 the plane normal to the central chord
+c_0 = x_1 - x_prev (x_prev the vertex before x_0 on b's rod), at x_1 the one normal to
+c_1 = x_next - x_0, and s_i = 2 (P - x_i) . c_i / |c_i|^2 the scaled signed distance of P
+from plane i (s_0 = v and s_1 = v - 1 along a straight partner of equal edges). Then
+omega = S(s_0 + 1/2) - S(s_1 + 1/2), S the quintic step (S(2 s_0 + 1) on the first edge of
+an open rod, S(2 s_1) on the last: its surface fades over half an edge past the end), and
+0 where that difference is not positive (beyond the line where the two planes cross, near
+the partner's centre of curvature). Consecutive edges share a vertex and its chord, so
+their terms cancel in the sum over the edges about P, which is 1 for any bend and any edge
+lengths while P is well within a radius of curvature 1 / kappa of the axis (rho kappa up to
+0.7 with kappa the largest over the edges that weigh P: a point far from the axis is
+weighed over about 1 / (1 - rho kappa) edges; nearer the centre the planes of consecutive
+vertices cross). Parts of the rod that curl back towards P from beyond their own centre of
+curvature can add weight there, never where P is in contact with them. Along a straight
+partner of equal edges omega is the quintic hat of v on [-1/2, 3/2]
+(:func:`partition_weight`). A missing neighbour (an open rod's end, or one not given) is
+the ghost of a straight continuation, x_prev = 2 x_0 - x_1, x_next = 2 x_1 - x_0. Pairs of
+one rod take the
 exclusion ramp W of the compliant level on the rest arcs of P's Gauss point and of its
 projection (:mod:`tightknot.contact.pair_law`). The energy of a sample is
 (1/2) A omega W phi(pen), pen = -g, A = w_u l_bar r0 2 pi / M its rest area and phi the
@@ -42,10 +59,14 @@ second derivatives in the coefficients and their mixed ones in the stretch and v
 but for the frames' second derivatives, which are central differences of their exact first
 ones (:data:`FRAME_STEP`): b's cylinder coordinates
 (v, rho, psi) of a sample carry their exact Hessians over (P - x_b0, x_b1 - x_b0)
-(:func:`cylinder_coordinates`), and P its own over a's edge vector.
+(:func:`cylinder_coordinates`), the partition its own over P and b's four vertices, and P
+its own over a's edge vector.
 
-Local dofs of a pair, in this order: x_a0, x_a1, x_b0, x_b1 (3 each), then the section
-coefficients of a's two vertices (K each, as stored), then b's two.
+Local dofs of a pair (L = 24 + 4 K), in this order: x_a0, x_a1, x_b0, x_b1 (3 each), then
+the section coefficients of a's two vertices (K each, as stored), then b's two, then the
+rods' neighbouring vertices of the partition, x_a_prev, x_a_next, x_b_prev, x_b_next (3
+each, from 12 + 4 K; zero rows and columns where a neighbour is a ghost, its dependence
+carried onto the edge's own vertices).
 """
 
 from __future__ import annotations
@@ -112,9 +133,11 @@ def quintic_step(x: NDArray) -> tuple[NDArray, NDArray, NDArray]:
 def partition_weight(v: NDArray, first_open: bool, last_open: bool
                      ) -> tuple[NDArray, NDArray, NDArray]:
     """omega(v) of a partner edge and its first two derivatives: S(v + 1/2) on [-1/2, 1/2],
-    1 - S(v - 1/2) on [1/2, 3/2] (consecutive edges' hats sum to one). The first or last edge
-    of an open rod keeps the weight 1 up to its end vertex and fades over the next half edge,
-    S(2 v + 1) below v = 0 and 1 - S(2 v - 2) above v = 1."""
+    1 - S(v - 1/2) on [1/2, 3/2] (consecutive edges' hats sum to one along a straight partner
+    of equal edges only). The first or last edge of an open rod keeps the weight 1 up to its
+    end vertex and fades over the next half edge, S(2 v + 1) below v = 0 and 1 - S(2 v - 2)
+    above v = 1. The contact weighs its samples by :func:`partition` instead, which is this
+    hat along a straight partner of equal edges and sums to one along any polyline."""
     v = np.asarray(v, dtype=np.float64)
     lo_s, lo_1, lo_2 = quintic_step(2.0 * v + 1.0) if first_open else quintic_step(v + 0.5)
     lo_1, lo_2 = (2.0 * lo_1, 4.0 * lo_2) if first_open else (lo_1, lo_2)
@@ -126,6 +149,69 @@ def partition_weight(v: NDArray, first_open: bool, last_open: bool
     w1 = np.where(low_side, lo_1, np.where(high_side, -hi_1, 0.0))
     w2 = np.where(low_side, lo_2, np.where(high_side, -hi_2, 0.0))
     return w, w1, w2
+
+
+def _plane_distance(y: NDArray, c: NDArray) -> tuple[float, NDArray, NDArray]:
+    """s = 2 y . c / (c . c) [-] of a point at y = P - x_i [m] from the plane through x_i
+    normal to the chord c [m], with its gradient (6,) and Hessian (6, 6) over (y, c)."""
+    dd = float(c @ c)
+    yc = float(y @ c)
+    s = 2.0 * yc / dd
+    grad = np.concatenate([2.0 * c / dd, 2.0 * y / dd - 4.0 * yc * c / dd**2])
+    hess = np.zeros((6, 6))
+    hess[:3, 3:] = 2.0 * np.eye(3) / dd - 4.0 * np.outer(c, c) / dd**2
+    hess[3:, :3] = hess[:3, 3:].T
+    hess[3:, 3:] = (-4.0 * (np.outer(y, c) + np.outer(c, y)) / dd**2
+                    - 4.0 * yc * np.eye(3) / dd**2 + 16.0 * yc * np.outer(c, c) / dd**3)
+    return s, grad, hess
+
+
+def partition(p: NDArray, x_prev: NDArray | None, x0: NDArray, x1: NDArray,
+              x_next: NDArray | None, first_open: bool, last_open: bool
+              ) -> tuple[float, NDArray, NDArray]:
+    """omega(P) [-] of the partner edge (x0, x1) [m] at the point ``p`` [m] (module
+    docstring): S(s_0 + 1/2) - S(s_1 + 1/2) on the bisector planes of the edge's vertices,
+    x_prev and x_next [m] the rod's vertices before x0 and after x1 (None: the ghost of a
+    straight continuation), clamped at 0. Returns omega, its gradient (15,) [1/m] and Hessian
+    (15, 15) [1/m^2] over (P, x_prev, x0, x1, x_next); a ghost's rows and columns are zero,
+    its dependence carried onto x0 and x1."""
+    ghost_prev, ghost_next = x_prev is None, x_next is None
+    xp = 2.0 * x0 - x1 if x_prev is None else x_prev
+    xn = 2.0 * x1 - x0 if x_next is None else x_next
+    eye = np.eye(3)
+    # (y, c) of each plane over z = (P, x_prev, x0, x1, x_next): y_0 = P - x0,
+    # c_0 = x1 - x_prev, y_1 = P - x1, c_1 = x_next - x0
+    j0 = np.zeros((6, 15))
+    j0[:3, 0:3], j0[:3, 6:9] = eye, -eye
+    j0[3:, 9:12], j0[3:, 3:6] = eye, -eye
+    j1 = np.zeros((6, 15))
+    j1[:3, 0:3], j1[:3, 9:12] = eye, -eye
+    j1[3:, 12:15], j1[3:, 6:9] = eye, -eye
+    omega = 0.0
+    grad = np.zeros(15)
+    hess = np.zeros((15, 15))
+    # sigma_i = S(scale s_i + shift); omega = sigma_0 - sigma_1
+    for sign, y, c, jac, scale, shift in (
+            (1.0, p - x0, x1 - xp, j0, *((2.0, 1.0) if first_open else (1.0, 0.5))),
+            (-1.0, p - x1, xn - x0, j1, *((2.0, 0.0) if last_open else (1.0, 0.5)))):
+        s, gs, hs = _plane_distance(y, c)
+        st, st1, st2 = (float(z) for z in quintic_step(np.array(scale * s + shift)))
+        gz = jac.T @ gs
+        omega += sign * st
+        grad += sign * scale * st1 * gz
+        hess += sign * (scale**2 * st2 * np.outer(gz, gz) + scale * st1 * (jac.T @ hs @ jac))
+    if omega <= 0.0:
+        # the planes cross past the centre of curvature: no weight there
+        return 0.0, np.zeros(15), np.zeros((15, 15))
+    # a ghost is linear in x0, x1: z_full = T z carries its rows onto them exactly
+    fold = np.eye(15)
+    if ghost_prev:
+        fold[3:6, 3:6] = 0.0
+        fold[3:6, 6:9], fold[3:6, 9:12] = 2.0 * eye, -eye
+    if ghost_next:
+        fold[12:15, 12:15] = 0.0
+        fold[12:15, 9:12], fold[12:15, 6:9] = 2.0 * eye, -eye
+    return omega, fold.T @ grad, fold.T @ hess @ fold
 
 
 @dataclass
@@ -147,6 +233,9 @@ class EdgeSection:
         rigid: a rigid section (radius r0, coefficients ignored, no thinning).
         arc: rest arcs of the edge's ends [m] (the exclusion window's).
         first_open, last_open: the edge is the first / last of an open rod.
+        x_prev, x_next: the rod's vertices [m] before x0 and after x1, which shape the
+            partition (:func:`partition`); None for the ghost of a straight continuation
+            (an open rod's end, or a caller that gives no neighbours).
     """
 
     x0: NDArray
@@ -163,6 +252,8 @@ class EdgeSection:
     arc: tuple[float, float] = (0.0, 0.0)
     first_open: bool = False
     last_open: bool = False
+    x_prev: NDArray | None = None
+    x_next: NDArray | None = None
 
 
 @dataclass
@@ -338,8 +429,10 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
     omega W of the sample [-]."""
     modes = np.asarray(st.modes, dtype=np.float64)
     k = 2 * modes.size
-    nloc = 12 + 4 * k
+    nloc = 24 + 4 * k
     ia0, ia1, ib0, ib1 = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)
+    nb = 12 + 4 * k  # the neighbours' block
+    ib_prev, ib_next = slice(nb + 6, nb + 9), slice(nb + 9, nb + 12)
     vec_a = ea_.x1 - ea_.x0
     vec_b = eb_.x1 - eb_.x0
     la, lb = float(np.linalg.norm(vec_a)), float(np.linalg.norm(vec_b))
@@ -362,6 +455,12 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
     lam_b_dir = np.concatenate([np.zeros(3), tb / eb_.rest])  # d lambda_b / d(w, e)
     lam_b_hess = np.zeros((6, 6))
     lam_b_hess[3:, 3:] = (np.eye(3) - np.outer(tb, tb)) / (lb * eb_.rest)
+    # the partition's (P, x_prev, x0, x1, x_next) over the local dofs, but for P's rows
+    # (the sample's own, filled per sample); a ghost's rows carry a zero gradient
+    om_rows = np.zeros((15, nloc))
+    for rows, cols in ((slice(3, 6), ib_prev), (slice(6, 9), ib0), (slice(9, 12), ib1),
+                       (slice(12, 15), ib_next)):
+        om_rows[rows, cols] = np.eye(3)
     dcb = zero if eb_.rigid else interpolated(eb_, modes, 1.0)[0] - eb_.coeffs0
     rot_b1 = interpolated(eb_, modes, 1.0)[1]
     for u, wu in zip(st.gauss_xi, st.gauss_w, strict=True):
@@ -389,9 +488,9 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
             rb_mean, rb_l, rb_ll, rb_c = radius_partials(eb_, lb, cb)
             r_b = rb_mean + float(b0 @ cb)
             pen = r_b - rho
-            # weights: partner partition and exclusion ramp
-            om, om1, om2 = (float(z) for z in partition_weight(np.array(v), eb_.first_open,
-                                                                 eb_.last_open))
+            # weights: partner partition (of P) and exclusion ramp (of v)
+            om, om_g, om_h = partition(p, eb_.x_prev, eb_.x0, eb_.x1, eb_.x_next,
+                                       eb_.first_open, eb_.last_open)
             wex, wex1, wex2 = 1.0, 0.0, 0.0
             if st.same_rod:
                 s_a = ea_.arc[0] + u * (ea_.arc[1] - ea_.arc[0])
@@ -406,8 +505,6 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
                 dsdv = sgn * (eb_.arc[1] - eb_.arc[0])
                 wex, wex1, wex2 = float(ww[0]), float(ww[1]) * dsdv, float(ww[2]) * dsdv**2
             wt = om * wex
-            wt1 = om1 * wex + om * wex1
-            wt2 = om2 * wex + 2.0 * om1 * wex1 + om * wex2
             pens.append(pen)
             weights.append(wt)
             if wt == 0.0 or pen <= 0.0:
@@ -454,8 +551,13 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
                     - rb_ll * np.outer(lam_b_dir, lam_b_dir) - rb_l * lam_b_hess)
             grad_g = jwe.T @ g_we - e_beta
             grad_v = jwe.T @ gv
-            # energy a_s wt(v) phi(-g)
-            grad += a_s * (-wt * ph1 * grad_g + ph * wt1 * grad_v)
+            om_rows[:3] = dp
+            grad_om = om_rows.T @ om_g
+            # wt = omega(P, b's vertices) W(v): dwt/dP, and over the local dofs
+            wt_p = wex * om_g[:3] + om * wex1 * gv[:3]
+            grad_wt = wex * grad_om + om * wex1 * grad_v
+            # energy a_s wt phi(-g)
+            grad += a_s * (-wt * ph1 * grad_g + ph * grad_wt)
             if not want_hess:
                 continue
             # second derivatives of g and v over the local dofs
@@ -465,8 +567,10 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
             hg -= np.outer(psi_l, e_gamma) + np.outer(e_gamma, psi_l)
             hg -= np.outer(v_l, e_delta) + np.outer(e_delta, v_l)
             hvl = jwe.T @ cyl["hv"] @ jwe
-            # P's own second derivatives (a's side), contracted with dg/dw and dv/dw
-            for gw, target in ((g_we[:3], hg), (gv[:3], hvl)):
+            hom = om_rows.T @ om_h @ om_rows
+            # P's own second derivatives (a's side), contracted with dg/dw, dv/dw and
+            # d omega/dP
+            for gw, target in ((g_we[:3], hg), (gv[:3], hvl), (om_g[:3], hom)):
                 pee = (r_a * np.einsum("k,kij->ij", gw, cphi * t1a + sphi * t2a)
                        + np.outer(gw @ m_dir, dra) + np.outer(dra, gw @ m_dir)
                        + float(gw @ dirv) * hra)
@@ -479,16 +583,17 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
                     row[ia1] = gw @ m_dir
                     row[ia0] = -row[ia1]
                     target += np.outer(row, e_alpha) + np.outer(e_alpha, row)
+            hwt = (wex * hom + wex1 * (np.outer(grad_om, grad_v) + np.outer(grad_v, grad_om))
+                   + om * (wex2 * np.outer(grad_v, grad_v) + wex1 * hvl))
             h = wt * ph2 * np.outer(grad_g, grad_g) - wt * ph1 * hg
-            h -= ph1 * wt1 * (np.outer(grad_g, grad_v) + np.outer(grad_v, grad_g))
-            h += ph * (wt2 * np.outer(grad_v, grad_v) + wt1 * hvl)
+            h -= ph1 * (np.outer(grad_g, grad_wt) + np.outer(grad_wt, grad_g))
+            h += ph * hwt
             hess += a_s * h
             # The mean radii's second derivatives in the coefficients, and mixed in the
             # stretch and (b's) in v, times dE/dr: R = sqrt(S(lam) - |c|^2 / 2) has
             # R_cc = -I / (2 R) - c c^T / (4 R^3) and R_clam = c R_lam / (2 R^2).
             if not ea_.rigid:
-                g_alpha = a_s * (-wt * ph1 * float(g_we[:3] @ dirv)
-                                 + ph * wt1 * float(gv[:3] @ dirv))
+                g_alpha = a_s * (-wt * ph1 * float(g_we[:3] @ dirv) + ph * float(wt_p @ dirv))
                 map_a = np.zeros((nloc, k))
                 map_a[12:12 + k] = (1.0 - u) * np.eye(k)
                 map_a[12 + k:12 + 2 * k] = rot_a.T
@@ -497,7 +602,7 @@ def pass_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: 
             if not eb_.rigid:
                 map_b = np.zeros((nloc, k))
                 map_b[12 + 2 * k:12 + 3 * k] = (1.0 - v) * np.eye(k)
-                map_b[12 + 3 * k:] = rot_b.T
+                map_b[12 + 3 * k:nb] = rot_b.T
                 hess += a_s * wt * ph1 * _radius_second(map_b, cb, rb_mean, rb_l,
                                                         tb / eb_.rest, ib0, ib1,
                                                         (dcb, grad_v))
@@ -529,9 +634,13 @@ def _radius_second(cmap: NDArray, c: NDArray, big_r: float, r_lam: float,
 
 
 def swap_order(k: int) -> NDArray:
-    """Local dof permutation taking a pass of (b, a) to the pair order (a, b)."""
+    """Local dof permutation taking a pass of (b, a) to the pair order (a, b): entry i is
+    the pair's index of the pass's dof i (its a is the pair's b, and the neighbours swap
+    with the edges)."""
+    nb = 12 + 4 * k
     return np.concatenate([np.arange(6, 12), np.arange(0, 6),
-                           np.arange(12 + 2 * k, 12 + 4 * k), np.arange(12, 12 + 2 * k)])
+                           np.arange(12 + 2 * k, 12 + 4 * k), np.arange(12, 12 + 2 * k),
+                           np.arange(nb + 6, nb + 12), np.arange(nb, nb + 6)])
 
 
 def pair_terms(ea_: EdgeSection, eb_: EdgeSection, st: PairSettings, want_hess: bool = True

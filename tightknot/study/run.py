@@ -306,8 +306,10 @@ def calibration_range(scene: KnotScene, contact: ContactReport, x: np.ndarray | 
         weight_sum = contact.weight_sum_mean  # None but at the sectioned level
         if weight_sum is not None and abs(weight_sum - 1.0) > WEIGHT_SUM_TOLERANCE:
             warnings.append(f"the sections' contacts weigh {weight_sum:.3g} times on average "
-                            "where the penalty was calibrated at one: on a bent partner the "
-                            "weights that blend its edges do not sum to one (a known bias, "
+                            "where the penalty was calibrated at one: the weights that blend a "
+                            "partner's edges do not sum to one there (contacts on the inside "
+                            "of a partner bent tighter than the partition is exact for, "
+                            "rho kappa above about 0.7, or inside a rod's exclusion ramp; "
                             "docs/sectioned_level.md, 'The partner's partition of unity on a "
                             "bent partner')")
         nus = {r.material.poisson_ratio for r in scene.model.rods}
