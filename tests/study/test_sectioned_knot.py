@@ -382,3 +382,28 @@ def test_a_failed_section_solve_settles_again_from_its_start(monkeypatch,
         _closed_length(ref.system.state.x), rel=2e-4)
     assert res.system.last_split.total == pytest.approx(ref.system.last_split.total,
                                                         rel=1e-5)
+
+
+def test_a_fine_closed_trefoil_settles_in_its_first_section_solve(monkeypatch) -> None:
+    """At the CLI's default 234 vertices the free closed knot's near-rigid modes
+    (eigenvalues 1e-11 of its Hessian's diagonal) can make PARDISO count negative pivots of
+    a positive definite Hessian; section_finish's first solve then shifts by
+    DIRECT_SECTION_SHIFT_INERTIA (1e-10 of the diagonal) and converges without the
+    homotopy (measured 16 iterations; with the default first rung, 1e-6, it stalled at a
+    residual of 1e-3 and took the homotopy and proximal steps, 185 s)."""
+    import tightknot.loading.tie as tie_module
+
+    real = tie_module.static_solve
+    scene = closed_trefoil(16.37, nodes=234, contact="sectioned")
+    seen: list[tuple[float, int, bool]] = []
+
+    def spy(system, newton_options, *args, **kwargs):
+        out = yield from real(system, newton_options, *args, **kwargs)
+        if not scene.contact.gauss_newton:
+            seen.append((scene.contact.penalty_scale, newton_options.max_iterations,
+                         out[0].converged))
+        return out
+
+    res = _tied_final_with(monkeypatch, scene, spy)
+    assert res.converged
+    assert seen == [(1.0, tie_module.DIRECT_SECTION_ITERATIONS, True)]
