@@ -103,12 +103,11 @@ def _unpack(a: EdgeSection, b: EdgeSection, q: np.ndarray) -> tuple[EdgeSection,
     return a, b
 
 
-def test_oracle_derivatives_match_finite_differences() -> None:
-    a, b = _pair()
+def central_differences(a: EdgeSection, b: EdgeSection, eps: float = 1e-7
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """The oracle's gradient and Hessian over the pair's local dofs (:func:`_pack`) by
+    central differences (step ``eps``) of its energy and of its gradient."""
     q0 = _pack(a, b)
-    ref = pair_terms(a, b, SETTINGS)
-    assert ref["energy"] > 0.0 and ref["pen_a"].max() > 0.01  # a real contact
-    eps = 1e-7
     g_fd = np.zeros(q0.size)
     h_fd = np.zeros((q0.size, q0.size))
     for i in range(q0.size):
@@ -118,6 +117,14 @@ def test_oracle_derivatives_match_finite_differences() -> None:
         lo = pair_terms(*_unpack(a, b, q0 - dq), SETTINGS)
         g_fd[i] = (hi["energy"] - lo["energy"]) / (2 * eps)
         h_fd[:, i] = (hi["grad"] - lo["grad"]) / (2 * eps)
+    return g_fd, h_fd
+
+
+def test_oracle_derivatives_match_finite_differences() -> None:
+    a, b = _pair()
+    ref = pair_terms(a, b, SETTINGS)
+    assert ref["energy"] > 0.0 and ref["pen_a"].max() > 0.01  # a real contact
+    g_fd, h_fd = central_differences(a, b)
     # exact: central differences of a C2 energy leave truncation eps^2 and round-off
     # 1e-16 E / eps (measured 3.6e-10 of the largest entry)
     assert np.max(np.abs(ref["grad"] - g_fd)) <= 1e-7 * np.max(np.abs(g_fd))

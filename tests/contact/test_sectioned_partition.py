@@ -3,31 +3,25 @@
 one over any bent polyline, the open ends' fades, the old hat along a straight partner, and
 the oracle's derivatives over all local dofs on a bent partner."""
 
-import copy
 import math
 
 import numpy as np
 import pytest
 
+from tests.contact.test_sectioned import (
+    SETTINGS,
+    K,
+    _pack,
+    _unit,
+    central_differences,
+)
 from tightknot.contact.sectioned_reference import (
     EdgeSection,
-    PairSettings,
     pair_terms,
     partition,
     partition_weight,
     quintic_step,
 )
-
-MODES = np.arange(2, 9)
-K = 2 * MODES.size
-GAUSS = (np.array([0.5 - 0.5 / math.sqrt(3.0), 0.5 + 0.5 / math.sqrt(3.0)]),
-         np.array([0.5, 0.5]))
-SETTINGS = PairSettings(modes=MODES, gauss_xi=GAUSS[0], gauss_w=GAUSS[1], samples=32,
-                        kappa=1000.0, onset=1e-4)
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v)
 
 
 def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
@@ -251,22 +245,6 @@ def _bent_pair(seed: int = 1) -> tuple[EdgeSection, EdgeSection]:
     return a, b
 
 
-def _pack(a: EdgeSection, b: EdgeSection) -> np.ndarray:
-    return np.concatenate([a.x0, a.x1, b.x0, b.x1, a.coeffs0, a.coeffs1, b.coeffs0,
-                           b.coeffs1, a.x_prev, a.x_next, b.x_prev, b.x_next])
-
-
-def _unpack(a: EdgeSection, b: EdgeSection, q: np.ndarray) -> tuple[EdgeSection, EdgeSection]:
-    a, b = copy.copy(a), copy.copy(b)
-    a.x0, a.x1, b.x0, b.x1 = q[0:3], q[3:6], q[6:9], q[9:12]
-    nb = 12 + 4 * K
-    a.coeffs0, a.coeffs1 = q[12:12 + K], q[12 + K:12 + 2 * K]
-    b.coeffs0, b.coeffs1 = q[12 + 2 * K:12 + 3 * K], q[12 + 3 * K:nb]
-    a.x_prev, a.x_next, b.x_prev, b.x_next = (q[nb:nb + 3], q[nb + 3:nb + 6], q[nb + 6:nb + 9],
-                                              q[nb + 9:nb + 12])
-    return a, b
-
-
 def test_oracle_derivatives_on_a_bent_partner_match_finite_differences() -> None:
     a, b = _bent_pair()
     q0 = _pack(a, b)
@@ -276,16 +254,7 @@ def test_oracle_derivatives_on_a_bent_partner_match_finite_differences() -> None
     # samples in contact in the partition's ramps, in both passes
     for pen, wt in ((ref["pen_a"], ref["weight_a"]), (ref["pen_b"], ref["weight_b"])):
         assert np.sum((pen > 0.0) & (wt > 0.0) & (wt < 0.99)) >= 3
-    eps = 1e-7
-    g_fd = np.zeros(q0.size)
-    h_fd = np.zeros((q0.size, q0.size))
-    for i in range(q0.size):
-        dq = np.zeros(q0.size)
-        dq[i] = eps
-        hi = pair_terms(*_unpack(a, b, q0 + dq), SETTINGS)
-        lo = pair_terms(*_unpack(a, b, q0 - dq), SETTINGS)
-        g_fd[i] = (hi["energy"] - lo["energy"]) / (2 * eps)
-        h_fd[:, i] = (hi["grad"] - lo["grad"]) / (2 * eps)
+    g_fd, h_fd = central_differences(a, b)
     g = ref["grad"]
     nb = 12 + 4 * K
     # every neighbour moves the energy through its chord (both passes, both ends)

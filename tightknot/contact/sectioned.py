@@ -557,15 +557,15 @@ class SectionedLayer(ContactLayer):
         return energy, grad, coo
 
     # -- contact between deformed boundaries ---------------------------------------------
-    def _partition_reach(self, x: np.ndarray, radius: np.ndarray) -> np.ndarray:
-        """How far [m] past its vertices each edge's partition weight reaches along its axis
-        within ``radius`` [m] of it (the kernels' ``reach_range``): half an edge on a
-        straight rod, more on the outside of a bend. A chord at more than 78 degrees to
-        its edge (a vertex turning by more than about 157 degrees, a rod folded through
-        itself) is taken at 78 degrees."""
+    def _partition_reach(self, x: np.ndarray, e: np.ndarray, length: np.ndarray,
+                         radius: np.ndarray) -> np.ndarray:
+        """How far [m] past its vertices each edge (vectors ``e``, lengths ``length`` [m]
+        at positions ``x``) has its partition weight reach along its axis within
+        ``radius`` [m] of it (the kernels' ``reach_range``): half an edge on a straight
+        rod, more on the outside of a bend. A chord at more than 78 degrees to its edge (a
+        vertex turning by more than about 157 degrees, a rod folded through itself) is
+        taken at 78 degrees."""
         ev = self._ev
-        e = x[ev[:, 1]] - x[ev[:, 0]]
-        length = np.linalg.norm(e, axis=1)
         t = e / length[:, None]
         nb = self.edge_neighbour
         prev = np.where(nb[:, :1] >= 0, x[np.maximum(nb[:, 0], 0)], 2.0 * x[ev[:, 0]] - x[ev[:, 1]])
@@ -584,9 +584,10 @@ class SectionedLayer(ContactLayer):
         for compression, plus 1.5 times its vertices' mode amplitudes, sum_n sqrt(a_n^2 +
         b_n^2), each) and how far its partition weight reaches past its vertices within
         that radius (:meth:`_partition_reach`: half its length on a straight rod); and that
-        last part alone [m]."""
+        last part alone, in rest arc [m]."""
         ev = self._ev
-        length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
+        e = x[ev[:, 1]] - x[ev[:, 0]]
+        length = np.linalg.norm(e, axis=1)
         lam = length / rest
         if self.rod_mean is not None:
             lam = np.minimum(lam, self.rod_mean.stretch(x, rest))
@@ -597,22 +598,20 @@ class SectionedLayer(ContactLayer):
             pairs = extra.reshape(-1, k // 2, 2)
             vsum[~self.vertex_rigid] = np.sqrt(np.sum(pairs * pairs, axis=2)).sum(axis=1)
             reach += 1.5 * (vsum[ev[:, 0]] + vsum[ev[:, 1]])
-        past = self._partition_reach(x, reach)
-        return reach + past, past
+        past = self._partition_reach(x, e, length, reach)
+        return reach + past, past * rest / length
 
     def _candidates(self, x: np.ndarray, extra: np.ndarray, rest: np.ndarray
                     ) -> tuple[wp.array, wp.array, wp.array, wp.array]:
         broad = self.broad_phase
         wx = broad.x_in.put(x)
         arcs, rod_len = broad.arcs(rest)
-        margins, past = self._margins(x, extra, rest)
+        margins, past_arc = self._margins(x, extra, rest)
         margin = self._in_margin.put(margins)
         # A sample's projection reaches past a partner edge's vertices (half an edge on a
         # straight rod): keep pairs whose edges lie up to that much (in rest arc) inside
         # the exclusion window.
-        ev = self._ev
-        length = np.linalg.norm(x[ev[:, 1]] - x[ev[:, 0]], axis=1)
-        reach = float(np.max(past * rest / length)) / float(np.min(self.exclusion))
+        reach = float(np.max(past_arc)) / float(np.min(self.exclusion))
         pairs = broad.candidates(wx, broad.zero_dx, margin, arcs, rod_len,
                                  window=max(0.0, self.settings.candidate_window - reach))
         return wx, pairs, arcs, rod_len
@@ -733,7 +732,7 @@ class SectionedLayer(ContactLayer):
         over the rods of their edges."""
         nrod = len(self.model.rods)
         rod_of = np.asarray(self.model.edge_rod, dtype=np.int64)
-        order = np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)  # pass: A, B
+        order = _pass_edges(pairs)
         return (np.bincount(rod_of[order[:, 0]], dlam[:, 0], nrod)
                 + np.bincount(rod_of[order[:, 1]], dlam[:, 1], nrod))
 
@@ -800,7 +799,7 @@ class SectionedLayer(ContactLayer):
         """The vertices of each pass (2 P, 6): A's two, B's two, and B's neighbours on its
         rod (-1 at an open end); pass 2p takes (a, b), pass 2p + 1 takes (b, a)."""
         ev = self._ev
-        order = np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)  # (2P, 2): A, B
+        order = _pass_edges(pairs)
         return np.concatenate([ev[order[:, 0]], ev[order[:, 1]],
                                self.edge_neighbour[order[:, 1]]], axis=1)
 
@@ -960,7 +959,7 @@ class SectionedLayer(ContactLayer):
         k = self.section.coeff_count
         nl = 18 + 4 * k
         ev = self._ev
-        order = np.stack([act_pairs, act_pairs[:, ::-1]], axis=1).reshape(-1, 2)  # A, B
+        order = _pass_edges(act_pairs)
         full = self.vertex_sections(extra)
         grad, tcol = out["grad"], out["twist_col"]
         keep = dofs >= 0
@@ -1057,11 +1056,8 @@ class SectionedLayer(ContactLayer):
             return np.zeros(0, np.int64), np.zeros(0, np.int64), empty, empty
         data = self._state_arrays(extra, *frames, rest, arcs, rod_len, x)
         out = self._launch(sk.REPORT, wx, pairs, data, report=True)
-        host = pairs.numpy().astype(np.int64)
-        # thread 2 p samples pair p's first edge against its second, 2 p + 1 the reverse
-        owner = np.stack([host[:, 0], host[:, 1]], axis=1).reshape(-1)
-        partner = np.stack([host[:, 1], host[:, 0]], axis=1).reshape(-1)
-        return owner, partner, out["pen"], out["weight"]
+        order = _pass_edges(pairs.numpy().astype(np.int64))
+        return order[:, 0], order[:, 1], out["pen"], out["weight"]
 
     def weight_sums(self, x: np.ndarray, extra: np.ndarray,
                     frames: tuple[np.ndarray, np.ndarray, np.ndarray], rest: np.ndarray
@@ -1229,6 +1225,12 @@ def _rotate(c: np.ndarray, modes: np.ndarray, angle: np.ndarray, transpose: bool
     out[:, 0::2] = cs * a + sn * b
     out[:, 1::2] = -sn * a + cs * b
     return out
+
+
+def _pass_edges(pairs: np.ndarray) -> np.ndarray:
+    """Each pass's sample edge A and partner edge B (2 P, 2): pass (thread) 2 p samples pair
+    p's first edge against its second, 2 p + 1 the reverse."""
+    return np.stack([pairs, pairs[:, ::-1]], axis=1).reshape(-1, 2)
 
 
 def _per_sample(owner: np.ndarray, pen: np.ndarray, weight: np.ndarray, edge_count: int

@@ -276,11 +276,12 @@ def system_at(scene: KnotScene, done: RodSystem, history: bool = False) -> RodSy
 #: Newton iterations of :func:`section_finish`'s first solve at the full penalty.
 DIRECT_SECTION_ITERATIONS = 150
 #: The first shift, relative to the Hessian's diagonal, of :func:`section_finish`'s first
-#: solve after PARDISO reports a negative eigenvalue (NewtonOptions.shift_inertia, 1e-6 by
-#: default). A free closed knot's Hessian keeps near-rigid modes with eigenvalues 1e-11 of
-#: its diagonal, on which PARDISO's inertia of the perturbed LDL^T can count negative
-#: pivots of a positive definite matrix; a shift of 1e-6 then swamps those modes and Newton
-#: stalls at a residual of 1e-3 (docs/sectioned_level.md, "The fix: the chords' planes").
+#: solve after a refused factorization (its NewtonOptions.shift_initial and, after PARDISO
+#: reports a negative eigenvalue, shift_inertia: 1e-8 and 1e-6 by default). A free closed
+#: knot's Hessian keeps near-rigid modes with eigenvalues 1e-11 of its diagonal, on which
+#: PARDISO's inertia of the perturbed LDL^T can count negative pivots of a positive
+#: definite matrix; a shift of 1e-6 then swamps those modes and Newton stalls at a residual
+#: of 1e-3 (docs/sectioned_level.md, "The fix: the chords' planes").
 DIRECT_SECTION_SHIFT_INERTIA = 1e-10
 #: The residual, as a fraction of its start, at which :func:`section_finish`'s first solve
 #: leaves its Gauss-Newton phase for the exact Hessian, and that phase's most iterations.
