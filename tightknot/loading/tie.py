@@ -278,8 +278,8 @@ DIRECT_SECTION_ITERATIONS = 150
 #: The first shift, relative to the Hessian's diagonal, of :func:`section_finish`'s first
 #: solve after a refused factorization (its NewtonOptions.shift_initial and, after PARDISO
 #: reports a negative eigenvalue, shift_inertia: 1e-8 and 1e-6 by default). A free closed
-#: knot's Hessian keeps near-rigid modes with eigenvalues 1e-11 of its diagonal, on which
-#: PARDISO's inertia of the perturbed LDL^T can count negative pivots of a positive
+#: knot's Hessian keeps near-rigid modes with eigenvalues 1e-11 of its diagonal, within
+#: the round-off of its LDL^T, whose inertia can then count a negative pivot of a positive
 #: definite matrix; a shift of 1e-6 then swamps those modes and Newton stalls at a residual
 #: of 1e-3 (docs/sectioned_level.md, "The fix: the chords' planes").
 DIRECT_SECTION_SHIFT_INERTIA = 1e-10
