@@ -234,7 +234,8 @@ def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
     # several sectioned reports, a row each (with and without the bend shift), and the
     # two-soft-rod scenes' rows where a report carries them
     soft = {"levels": {"sectioned": {"scenes": {
-        "clasp": {"comparison": {"levels": [{"force_rel": 0.1}, {"force_rel": -0.2}]},
+        "clasp": {"comparison": {"levels": [{"force_rel": 0.1}, {"force_rel": -0.2}],
+                                 "worst": {"width_profile": 0.137}},
                   "fem_over_rod_time_ratio": 500.0}}}}}
     shifted = {**sec, "section_bend_shift": True, "soft_scenes": soft}
     table = level_truth(report, None, [sec, shifted])
@@ -242,9 +243,15 @@ def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
     assert [r["section_bend_shift"] for r in both] == [False, True]
     assert both[0]["soft"] is None
     assert both[1]["soft"] == {"clasp_force_rel": [-0.2, 0.1],
-                               "clasp_fem_over_rod_time_ratio": 500.0}
+                               "clasp_fem_over_rod_time_ratio": 500.0,
+                               "clasp_width_profile_max": 0.137}
     text = format_table(table)
     assert "| sectioned + bend shift |" in text and "-20.0 .. +10.0 %" in text
+    # the nip's L_c along the contact where the report compares it, n/a where not
+    shift_line = next(t for t in text.splitlines() if t.startswith("| sectioned + bend"))
+    assert "| 0.14 |" in shift_line
+    assert all(t.count("|") == shift_line.count("|") for t in text.splitlines()
+               if t.startswith("| "))
     assert "soft wrap and the clasp at compliant, smoothed, sectioned" in table["not_covered"]
 
 

@@ -10,6 +10,7 @@ pytest.importorskip("felupe")
 
 from tightknot.fem.crosscheck import APPROACH_LIMIT, TARGETS  # noqa: E402
 from tightknot.fem.crosscheck_soft import (  # noqa: E402
+    PROFILE_RODS,
     compare,
     finer_mesh,
     merge_fem_results,
@@ -172,7 +173,7 @@ def test_compare_with_the_finer_mesh():
 
 
 def test_soft_rows_from_one_coarse_level(soft_wrap_one_level, clasp_one_level,
-                                         soft_crossing_one_level):
+                                         soft_crossing_one_level, tmp_path):
     rows = soft_rows("coarse", {"soft_wrap": soft_wrap_one_level, "clasp": clasp_one_level,
                                 "soft_crossing": soft_crossing_one_level})
     json.dumps(rows, allow_nan=False)
@@ -192,12 +193,32 @@ def test_soft_rows_from_one_coarse_level(soft_wrap_one_level, clasp_one_level,
             assert row["fem_force"] > 0.0 and row["rod_force"] > 0.0
             assert row["met"]["force"] == (abs(row["force_rel"]) <= TARGETS["force_rel"])
             assert level["scenes"][name]["fem_over_rod_time_ratio"] > 1.0
+            # the profiles along the contact: both sides loaded at the middle or apex,
+            # judged at every FEM layer of the contact, no spread on the coarsest mesh
+            for rod in PROFILE_RODS[name]:
+                prof = row[f"profile_{rod}"]
+                assert prof["layers"] >= 1 and prof["fem_spread"] is None
+                assert prof["rows"][0]["s_over_d0"] == 0.0
+                assert prof["rows"][0]["reference_contact_fraction"] > 0.0
+                assert prof["rows"][0]["other_contact_fraction"] > 0.0
+                assert row["met"][f"width_profile_{rod}"] == (
+                    prof["width_fraction_max"] <= TARGETS["width_fraction"])
+                assert row["met"][f"area_profile_{rod}"] == (
+                    prof["area_points_max"] <= TARGETS["area_points"])
+            assert ("profile_b" in row) == (name == "soft_wrap")
         # the clasp's diagnostic: the rod model run again with its clamps moved by the
         # relaxed U's offset (measured 0.12 D0 later at the medium mesh, docs/fem_nip.md)
         clasp = level["scenes"]["clasp"]
         assert 0.0 < clasp["kinematic_offset"]["clamp_travel_over_d0"] < 0.3
         assert clasp["comparison"]["levels"][0]["rod_force_kinematics_matched"] > 0.0
     assert rows["passed"] == rows["levels"]["compliant"]["passed"]
+    # the same rows drawn side by side (tightknot fem crosscheck --figure)
+    from tightknot.viz.profile_figures import plot_soft_profiles
+
+    out = tmp_path / "profiles.png"
+    assert plot_soft_profiles(rows, "compliant", out) == ["soft_wrap", "clasp",
+                                                          "soft_crossing"]
+    assert out.stat().st_size > 0
 
 
 def test_soft_rows_of_the_sectioned_level_with_the_bend_shift(

@@ -57,8 +57,9 @@ def _scene_errors(scenes: dict[str, Any]) -> dict[str, Any]:
 def _soft_errors(report: dict[str, Any], level: str) -> dict[str, Any] | None:
     """The two-soft-rod scenes' errors of ``level`` in a report's ``soft_scenes`` (the soft
     wrap's mid line load, the clasp's pull force and the soft crossing's force, min and
-    max over the compared load levels, and the FEM over rod time of each), None where the
-    report has none."""
+    max over the compared load levels, the FEM over rod time of each and, where the report
+    compares them, the largest L_c miss along the contact, ``{scene}_width_profile_max``),
+    None where the report has none."""
     entry = (report.get("soft_scenes") or {}).get("levels", {}).get(level)
     if entry is None:
         return None
@@ -66,6 +67,9 @@ def _soft_errors(report: dict[str, Any], level: str) -> dict[str, Any] | None:
     for name, sc in entry["scenes"].items():
         out[f"{name}_force_rel"] = _range(sc["comparison"]["levels"], "force_rel")
         out[f"{name}_fem_over_rod_time_ratio"] = sc["fem_over_rod_time_ratio"]
+        worst = sc["comparison"].get("worst", {})
+        if worst.get("width_profile") is not None:
+            out[f"{name}_width_profile_max"] = worst["width_profile"]
     return out
 
 
@@ -161,8 +165,9 @@ def format_table(table: dict[str, Any]) -> str:
              f"{table['fem_wall_time_s']:.0f} s of FEM)",
              "| level | indent force | wrap line load | soft wrap line load | clasp force | "
              "soft crossing force | area, max [points] | wrap curvature, max | L_c, max | "
+             "clasp L_c along the contact, max | "
              "rod time [s] | FEM / rod time | knots' time / compliant |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in table["rows"]:
         knots = row.get("knots")
         kt = ("n/a" if not knots or knots["time_ratio_to_compliant"] is None else
@@ -170,7 +175,7 @@ def format_table(table: dict[str, Any]) -> str:
               f"{knots['time_ratio_to_compliant'][1]:.2f}")
         if row["level"] == "rigid":
             lines.append(f"| rigid | n/a ({RIGID_REASON}) | n/a | n/a | n/a | n/a | n/a | n/a "
-                         f"| n/a | n/a | n/a | {kt} |")
+                         f"| n/a | n/a | n/a | n/a | {kt} |")
             continue
         area = max(row["indent_area_points_max"] or 0.0, row["wrap_area_points_max"] or 0.0)
         soft = row.get("soft") or {}
@@ -183,6 +188,8 @@ def format_table(table: dict[str, Any]) -> str:
             f"{100 * (row['wrap_curvature_rel_max'] or 0.0):.1f} % | "
             + ("n/a" if row["width_fraction_max"] is None
                else f"{row['width_fraction_max']:.2f}")
+            + (" | n/a" if soft.get("clasp_width_profile_max") is None
+               else f" | {soft['clasp_width_profile_max']:.2f}")
             + f" | {row['rod_wall_time_s']:.2f} | {row['fem_over_rod_time_ratio']:.0f} | {kt} |")
     lines.append(f"not covered: {table['not_covered']}")
     return "\n".join(lines)

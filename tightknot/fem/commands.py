@@ -103,6 +103,10 @@ def register(subparsers: Any) -> None:
                           "(tightknot fem SCENE --json), the first file holding a scene "
                           "and mesh winning; a scene on the next finer mesh is compared "
                           "too (the FEM's third mesh, reported)")
+    fem.add_argument("--figure", default=None, metavar="PNG",
+                     help="crosscheck only: draw the two-soft-rod scenes' profiles along "
+                          "the contact (L_c, A/A0, p/E; FEM and rod model side by side) to "
+                          "this PNG (needs the soft scenes: not with --no-soft)")
     fem.set_defaults(handler=_run_fem)
 
     cal = subparsers.add_parser(
@@ -141,6 +145,8 @@ def _run_fem(args: argparse.Namespace) -> int:
         return _fail(problem)
     if args.scene == "crosscheck":
         return _run_crosscheck(args)
+    if args.figure is not None:
+        return _fail(f"--figure draws a crosscheck's profiles; scene {args.scene!r} has none")
     from . import SOFT_SCENES
 
     if args.scene in SOFT_SCENES:
@@ -186,9 +192,13 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
     report is written either way), 2 for bad input or a missing FElupe."""
     from .scenes._common import finite
 
-    problem = _check_out(args.json)
+    problem = _check_out(args.json) or _check_out(args.figure)
     if problem:
         return _fail(problem)
+    if args.figure is not None and args.no_soft:
+        return _fail("--figure draws the soft scenes' profiles: it cannot go with --no-soft")
+    if args.figure is not None and not args.figure.endswith(".png"):
+        return _fail(f"--figure must name a .png file, got {args.figure!r}")
     try:
         from .crosscheck import DEFAULT_MESH, crosscheck
         from .crosscheck_soft import merge_fem_results
@@ -217,6 +227,10 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
         from tightknot.atomic import write_json_atomic
 
         write_json_atomic(args.json, report)
+    if args.figure is not None:
+        from tightknot.viz.profile_figures import plot_soft_profiles
+
+        plot_soft_profiles(report["soft_scenes"], report["contact"], args.figure)
     summary = {name: scene["comparison"]["worst"] for name, scene in report["scenes"].items()}
     line = {"contact": report["contact"], "passed": report["passed"],
             "fem_over_rod_time_ratio": report["fem_over_rod_time_ratio"], "worst": summary}

@@ -22,6 +22,10 @@ curvature              soft wrap: kappa D0 of the axis at the middle        |rel
                        (clasp: the apex's, reported only: the FEM's is the
                        section centroids', not the nominal axis's; the
                        crossing's straight rods: none)
+profiles along the     L_c and A/A0 at each FEM node layer where either     |diff| <= 0.1,
+contact                side is loaded, the rod model's interpolated in      <= 0.05
+                       its rest arc length (rod A; rod B too in the
+                       wrap; :mod:`tightknot.fem.profile_compare`)
 pressure               peak contact pressure over E                        reported only
 =====================  ==================================================  ==============
 
@@ -32,7 +36,9 @@ clasp's bends touch there is nothing to compare).
 Mesh spread (``fem_spread_rel``, per compared level): the relative difference of the
 compared FEM quantity between the comparison's mesh and the next coarser one (medium:
 coarse; fine: medium) at the same load level. On the coarse mesh there is none
-(``spread_mesh`` None). A rod-model error smaller than the spread is within what the FEM
+(``spread_mesh`` None); the profiles' spread (``fem_spread`` of ``profile_a``, ``profile_b``)
+is the coarser mesh's profile against the compared one's, with the same measure. A rod-model
+error smaller than the spread is within what the FEM
 itself can tell. Where the next finer mesh's run is given too (never run here: the fine
 meshes take tens of minutes; ``tightknot fem crosscheck --fem-json REPORT FINE``), each
 compared level also reports the compared mesh's difference from it
@@ -57,6 +63,7 @@ import time
 from typing import Any
 
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
+from .profile_compare import along_contact, spread_summary
 from .scenes._common import MESH_LEVELS, relative
 
 ROW_SCENES: tuple[str, ...] = ("soft_wrap", "clasp", "soft_crossing")
@@ -277,6 +284,7 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
         if b_key is not None:
             row.update({"fem_area_ratio_b": f[b_key], "rod_area_ratio_b": r[b_key],
                         "area_points_b": r[b_key] - f[b_key]})
+        row.update(profile_columns(scene, f, r, c))
         if g is not None:
             row.update(finer_columns(f, r, g, f_key, r_key, fa_key, fk_key))
         if m is not None:
@@ -287,17 +295,54 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
                       "converged": row["rod_converged"]}
         if b_key is not None:
             row["met"]["area_b"] = abs(row["area_points_b"]) <= TARGETS["area_points"]
+        for rod in PROFILE_RODS[scene]:
+            prof = row.get(f"profile_{rod}")
+            if prof is not None:
+                row["met"][f"width_profile_{rod}"] = (prof["width_fraction_max"]
+                                                      <= TARGETS["width_fraction"])
+                row["met"][f"area_profile_{rod}"] = (prof["area_points_max"]
+                                                     <= TARGETS["area_points"])
         if kappa_target:
             row["met"]["curvature"] = abs(row["curvature_rel"]) <= TARGETS["curvature_rel"]
         rows.append(row)
     worst = {k: max((abs(x[k]) for x in rows if x.get(k) is not None), default=None)
              for k in ("force_rel", "area_points", "area_points_b", "curvature_rel",
                        "pressure_rel")}
+    for key, name in (("width_profile", "width_fraction_max"),
+                      ("area_profile_points", "area_points_max")):
+        worst[key] = max((x[f"profile_{rod}"][name] for x in rows for rod in "ab"
+                          if x.get(f"profile_{rod}") is not None), default=None)
     spreads = [x["fem_spread_rel"]["force"] for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
             "fem_force_spread_max": max((abs(s) for s in spreads), default=None),
             **finer_summary(rows),
             "passed": bool(rows) and all(all(x["met"].values()) for x in rows)}
+
+
+#: Per scene: the rods whose profiles are compared along the contact (the clasp's U's and
+#: the crossing's rods are one another's images: A's only).
+PROFILE_RODS: dict[str, tuple[str, ...]] = {"soft_wrap": ("a", "b"), "clasp": ("a",),
+                                            "soft_crossing": ("a",)}
+
+
+def profile_columns(scene: str, fem: dict[str, Any], rod: dict[str, Any],
+                    coarser: dict[str, Any] | None) -> dict[str, Any]:
+    """A compared level's profiles along the contact (:func:`tightknot.fem.profile_compare.
+    along_contact`, the rod model's against the FEM's) per rod of :data:`PROFILE_RODS` whose
+    profile both steps hold (``profile_a``, ``profile_b``; None where neither is loaded),
+    each with the FEM's own spread on the same measure (``fem_spread``: the coarser mesh's
+    profile against the compared one's; None without it)."""
+    out: dict[str, Any] = {}
+    for rod_name in PROFILE_RODS[scene]:
+        key = f"profile_{rod_name}"
+        if key not in fem or key not in rod:
+            continue
+        comp = along_contact(fem[key], rod[key])
+        if comp is not None:
+            comp["fem_spread"] = (spread_summary(along_contact(fem[key], coarser[key]))
+                                  if coarser is not None and key in coarser else None)
+        out[key] = comp
+    return out
 
 
 def aligned_steps(fem_steps: list[dict], other: list[dict] | None) -> list[dict | None]:

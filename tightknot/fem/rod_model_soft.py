@@ -374,7 +374,8 @@ def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
     rods below, the stack's symmetry), ``approach_over_d0`` (2 w / D0),
     ``area_ratio_mid`` and ``area_ratio_mid_b`` (A's and B's crossing sections),
     ``peak_pressure_over_e`` and ``contact_width_fraction_mid`` (A's crossing section, its
-    two contacts); and the wall time."""
+    two contacts), ``profile_a`` (A from the crossing to its end, as the FEM's; B is its
+    image); and the wall time."""
     start = time.perf_counter()
     check_contact(contact)
     d0 = diameter
@@ -393,6 +394,9 @@ def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
                                for r, k in enumerate(levels) if k * side > 0])
 
     above, below = rods(1), rods(-1)
+    # rod A's vertices from the crossing on, with their rest arc length from it
+    va = np.arange(a_v, model.rods[0].vertex_start + edges[0] + 1)
+    s_a = (va - a_v) * (length_over_d0 * d0 / edges[0])
 
     def measure(w: float) -> dict[str, Any]:
         g = system.term_gradient(term)
@@ -407,6 +411,7 @@ def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "peak_pressure_over_e": float(rep.peak_pressure_over_E[a_v]),
             "contact_width_fraction_mid": float(rep.contact_width_fraction[a_v]),
             "contact_weight_sum_mean": rep.weight_sum_mean,
+            "profile_a": _profile(rep, va, s_a, d0),
         }
 
     rows = _solve_levels(system, load, list(w_levels), measure)

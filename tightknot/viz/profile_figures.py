@@ -1,0 +1,91 @@
+"""The FEM's and the rod model's profiles along the contact, side by side (issue 18): for
+each two-soft-rod scene of a cross-check report (the soft wrap's rod A, the clasp's U, the
+soft crossing's rod A), the contact width fraction L_c, A/A0 and p_max/E against the rest
+arc length s from the middle or apex, at each compared load level; the FEM's node layers
+solid with markers, the rod model's vertices dashed, one colour per level. The numbers
+behind it are the report's ``profile_a`` comparisons
+(:func:`tightknot.fem.profile_compare.along_contact`).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from typing import Any
+
+from tightknot.fem.profile_compare import arc_length as _s
+
+from .figures import save_png_atomic
+
+#: The plotted quantities: profile key, axis label.
+QUANTITIES = (("contact_fraction", "L_c"), ("area_ratio", "A/A0"),
+              ("peak_pressure_over_e", "p_max / E"))
+#: Scene titles and their load's label in the legend.
+SCENES = {"soft_wrap": ("soft wrap, rod A", "T/(E D0^2)"),
+          "clasp": ("clasp, U from its apex", "clamp travel/D0"),
+          "soft_crossing": ("soft crossing, rod A", "w/D0")}
+
+
+def _compared(soft: Mapping[str, Any], level: str, scene: str) -> list[tuple[Any, dict, dict]]:
+    """(load, FEM step, rod step) of each level the comparison judged."""
+    from tightknot.fem.crosscheck_soft import LOAD_KEYS
+
+    entry = soft["levels"][level]["scenes"].get(scene)
+    fem = soft["fem"].get(scene)
+    if entry is None or fem is None:
+        return []
+    loads = [row["load"] for row in entry["comparison"]["levels"]]
+    out = []
+    for f, r in zip(fem["steps"], entry["rod_steps"], strict=True):
+        if f[LOAD_KEYS[scene]] in loads and "profile_a" in f and "profile_a" in r:
+            out.append((f[LOAD_KEYS[scene]], f, r))
+    return out
+
+
+def plot_soft_profiles(soft: Mapping[str, Any], level: str,
+                       path: str | os.PathLike[str]) -> list[str]:
+    """Write the side-by-side profiles of a report's ``soft_scenes`` entry at contact
+    level ``level`` (a key of its ``levels``) to the PNG ``path``; returns the scenes
+    drawn. ValueError where the report holds no such level or no profile to draw."""
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    if level not in soft.get("levels", {}):
+        raise ValueError(f"the report's soft scenes hold no contact level {level!r} "
+                         f"(it has {sorted(soft.get('levels', {}))})")
+    scenes = [s for s in SCENES if _compared(soft, level, s)]
+    if not scenes:
+        raise ValueError("the report's soft scenes hold no compared level with profiles")
+    fig, axes = plt.subplots(len(scenes), len(QUANTITIES), squeeze=False,
+                             figsize=(4.2 * len(QUANTITIES), 3.0 * len(scenes)))
+    cmap = plt.get_cmap("viridis")
+    for i, scene in enumerate(scenes):
+        title, load_label = SCENES[scene]
+        steps = _compared(soft, level, scene)
+        ends = [max((_s(row) for row in prof if row["contact_fraction"] > 0.0),
+                    default=0.0) for _, f, r in steps for prof in (f["profile_a"],
+                                                                   r["profile_a"])]
+        s_max = 1.3 * max(ends) if max(ends) > 0.0 else 1.0
+        for k, (load, f, r) in enumerate(steps):
+            color = cmap(0.85 * k / max(len(steps) - 1, 1))  # viridis's last yellow is faint
+            for j, (key, label) in enumerate(QUANTITIES):
+                ax = axes[i, j]
+                for prof, style, who in ((f["profile_a"], {"marker": "o", "ms": 3,
+                                                           "linestyle": "-"}, "FEM"),
+                                         (r["profile_a"], {"linestyle": "--"}, "rod")):
+                    s = np.array([_s(row) for row in prof])
+                    v = np.array([row[key] for row in prof])
+                    keep = s <= s_max
+                    ax.plot(s[keep], v[keep], color=color, linewidth=1.2,
+                            label=f"{who}, {load_label} {load:.3g}" if j == 0 else None,
+                            **style)
+                ax.set_xlabel("s / D0 (rest, from the middle or apex)")
+                ax.set_ylabel(label)
+                ax.set_title(f"{title}: {label}", fontsize=9)
+                ax.grid(True, alpha=0.3)
+        axes[i, 0].legend(fontsize=6, ncol=2)
+    fig.suptitle(f"FEM (solid, node layers) against the rod model ({level} level, dashed)",
+                 fontsize=10)
+    fig.tight_layout()
+    save_png_atomic(fig, path)
+    return scenes
