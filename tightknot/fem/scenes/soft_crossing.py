@@ -155,7 +155,7 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
 
     def profile(x: np.ndarray, pressure: np.ndarray) -> list[dict[str, float]]:
         """Along rod A: per node layer z, A/A0, the contact width fraction L_c (the
-        loaded arc over the perimeter, both halves) and the peak pressure."""
+        loaded arcs of both contacts over the perimeter) and the peak pressure."""
         rows = []
         z_all = pa[nodes_a, 2]
         p_max = float(pressure.max())
@@ -171,9 +171,12 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
             xy = x[idx_a][layer][:, :2]
             perimeter = 4.0 * float(np.linalg.norm(xy[edges_sec[:, 1]] - xy[edges_sec[:, 0]],
                                                    axis=1).sum())
+            # both contacts of A's section, B above and its image below (the mid-plane's
+            # symmetry), each 2 b wide: the loaded part of the whole perimeter, as physics.md
+            # defines L_c and as the rod model counts it
             rows.append({"z_over_d0": float(z0) / diameter,
                          "area_ratio": section_area(xy, section.cells) / area0,
-                         "contact_fraction": 2.0 * b / perimeter,
+                         "contact_fraction": 4.0 * b / perimeter,
                          "peak_pressure_over_e": float(p_layer.max()) / youngs_modulus})
         return rows
 
