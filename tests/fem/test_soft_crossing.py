@@ -39,19 +39,6 @@ def test_small_crossing_symmetry_and_balance(small_crossing):
     assert ratio > 1.3
 
 
-def test_the_crossing_section_counts_both_of_its_contacts(soft_crossing_one_level):
-    # A in the stack is pressed by B above and by B's image below (the mid-plane): L_c is
-    # both contacts' chords, 2 x 2 a, over the perimeter (physics.md; the rod model counts
-    # both), here against a round section's perimeter of the same area (the section is
-    # flattened by a few per cent, its perimeter slightly longer: 5 %). Counting one
-    # contact, as the scene did until 2026-12-07, gives half.
-    step = soft_crossing_one_level["steps"][-1]
-    lc = step["profile_a"][0]["contact_fraction"]
-    both = 4.0 * step["semi_axis_transverse_over_d0"] / (math.pi
-                                                        * math.sqrt(step["area_ratio_mid"]))
-    assert lc == pytest.approx(both, rel=0.05)
-
-
 @SLOW
 def test_soft_crossing_is_stiffer_than_the_rigid_indent(soft_crossing_coarse):
     # measured soft/rigid force at w/D0 = 0.0094, 0.0375, 0.084, 0.15 (coarse): 1.60,

@@ -12,21 +12,21 @@ def _profile(width):
 
 
 def _soft(level="sectioned"):
-    fem_steps = [{"pull_over_d0": 0.3, "profile_a": _profile([0.0, 0.0])},
-                 {"pull_over_d0": 0.6, "profile_a": _profile([0.3, 0.1, 0.0])},
-                 {"pull_over_d0": 0.9, "profile_a": _profile([0.4, 0.2, 0.1, 0.0])}]
+    fem_steps = [{"approach_over_d0": 0.0, "profile_a": _profile([0.0, 0.0])},
+                 {"approach_over_d0": 0.05, "profile_a": _profile([0.3, 0.1, 0.0])},
+                 {"approach_over_d0": 0.1, "profile_a": _profile([0.4, 0.2, 0.1, 0.0])}]
     rod_steps = [{"profile_a": _profile([0.0, 0.0])},
                  {"profile_a": _profile([0.2, 0.1, 0.0])},
                  {"profile_a": _profile([0.3, 0.2, 0.0, 0.0])}]
     # the comparison judged the two levels in contact
-    comparison = {"levels": [{"load": 0.6}, {"load": 0.9}]}
+    comparison = {"levels": [{"load": 0.6, "approach_over_d0": 0.05},
+                             {"load": 0.9, "approach_over_d0": 0.1}]}
     return {"fem": {"clasp": {"steps": fem_steps}},
             "levels": {level: {"scenes": {"clasp": {"rod_steps": rod_steps,
                                                     "comparison": comparison}}}}}
 
 
 def test_the_profiles_are_drawn_for_the_compared_levels(tmp_path):
-    pytest.importorskip("felupe")  # the scenes' load keys live in tightknot.fem
     out = tmp_path / "profiles.png"
     assert plot_soft_profiles(_soft(), "sectioned", out) == ["clasp"]
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -34,7 +34,6 @@ def test_the_profiles_are_drawn_for_the_compared_levels(tmp_path):
 
 
 def test_a_missing_level_or_no_profile_is_a_clear_error(tmp_path):
-    pytest.importorskip("felupe")
     with pytest.raises(ValueError, match="no contact level 'compliant'"):
         plot_soft_profiles(_soft(), "compliant", tmp_path / "a.png")
     soft = _soft()

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -34,8 +35,11 @@ _CAL_EXAMPLES = """examples:
 """
 
 
-def register(subparsers: Any) -> None:
-    """Add the ``fem`` and ``calibrate`` subcommands to an argparse ``subparsers``."""
+def register(subparsers: Any, draw_profiles: Callable[..., Any] | None = None) -> None:
+    """Add the ``fem`` and ``calibrate`` subcommands to an argparse ``subparsers``;
+    ``draw_profiles(soft_scenes, level, path)`` draws ``crosscheck --figure`` (the command
+    line passes :func:`tightknot.viz.profile_figures.plot_soft_profiles`: pictures are a
+    layer above the FEM's)."""
     fem = subparsers.add_parser(
         "fem", help="run a small 3D solid FEM scene (needs tightknot[fem])",
         description="Run a FEM contact scene of a nearly incompressible neo-Hookean rod "
@@ -107,7 +111,7 @@ def register(subparsers: Any) -> None:
                      help="crosscheck only: draw the two-soft-rod scenes' profiles along "
                           "the contact (L_c, A/A0, p/E; FEM and rod model side by side) to "
                           "this PNG (needs the soft scenes: not with --no-soft)")
-    fem.set_defaults(handler=_run_fem)
+    fem.set_defaults(handler=_run_fem, draw_profiles=draw_profiles)
 
     cal = subparsers.add_parser(
         "calibrate", help="calibrate the radial-compliance contact law from the FEM",
@@ -199,6 +203,9 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
         return _fail("--figure draws the soft scenes' profiles: it cannot go with --no-soft")
     if args.figure is not None and not args.figure.endswith(".png"):
         return _fail(f"--figure must name a .png file, got {args.figure!r}")
+    if args.figure is not None and getattr(args, "draw_profiles", None) is None:
+        return _fail("--figure: this command line has no figures (tightknot[fem] without "
+                     "its drawing)")
     try:
         from .crosscheck import DEFAULT_MESH, crosscheck
         from .crosscheck_soft import merge_fem_results
@@ -228,9 +235,7 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
 
         write_json_atomic(args.json, report)
     if args.figure is not None:
-        from tightknot.viz.profile_figures import plot_soft_profiles
-
-        plot_soft_profiles(report["soft_scenes"], report["contact"], args.figure)
+        args.draw_profiles(report["soft_scenes"], report["contact"], args.figure)
     summary = {name: scene["comparison"]["worst"] for name, scene in report["scenes"].items()}
     line = {"contact": report["contact"], "passed": report["passed"],
             "fem_over_rod_time_ratio": report["fem_over_rod_time_ratio"], "worst": summary}

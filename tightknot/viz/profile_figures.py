@@ -13,8 +13,6 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-from tightknot.fem.profile_compare import arc_length as _s
-
 from .figures import save_png_atomic
 
 #: The plotted quantities: profile key, axis label.
@@ -26,19 +24,24 @@ SCENES = {"soft_wrap": ("soft wrap, rod A", "T/(E D0^2)"),
           "soft_crossing": ("soft crossing, rod A", "w/D0")}
 
 
-def _compared(soft: Mapping[str, Any], level: str, scene: str) -> list[tuple[Any, dict, dict]]:
-    """(load, FEM step, rod step) of each level the comparison judged."""
-    from tightknot.fem.crosscheck_soft import LOAD_KEYS
+def _s(row: Mapping[str, float]) -> float:
+    """A profile row's rest arc length [D0] (``z_over_d0`` along a straight rod)."""
+    return row["s_over_d0"] if "s_over_d0" in row else row["z_over_d0"]
 
+
+def _compared(soft: Mapping[str, Any], level: str, scene: str) -> list[tuple[Any, dict, dict]]:
+    """(load, FEM step, rod step) of each level the comparison judged: the FEM's steps
+    whose approach a compared row holds (the rod model ran at the FEM's levels, in
+    order)."""
     entry = soft["levels"][level]["scenes"].get(scene)
     fem = soft["fem"].get(scene)
     if entry is None or fem is None:
         return []
-    loads = [row["load"] for row in entry["comparison"]["levels"]]
+    judged = {row["approach_over_d0"]: row["load"] for row in entry["comparison"]["levels"]}
     out = []
     for f, r in zip(fem["steps"], entry["rod_steps"], strict=True):
-        if f[LOAD_KEYS[scene]] in loads and "profile_a" in f and "profile_a" in r:
-            out.append((f[LOAD_KEYS[scene]], f, r))
+        if f["approach_over_d0"] in judged and "profile_a" in f and "profile_a" in r:
+            out.append((judged[f["approach_over_d0"]], f, r))
     return out
 
 
