@@ -20,8 +20,9 @@ demo: venv
 
 # CI and `make test`: everything but the long checks (marked slow: the FEM's fine meshes),
 # on two workers (pytest-xdist), the cores CI has: Warp's CPU kernels run on one thread.
+# The 25 slowest tests are listed at the end: CI has 20 minutes on two cores.
 test: venv
-	$(BIN)/python -m pytest -q -m "not slow" -n 2
+	$(BIN)/python -m pytest -q -m "not slow" -n 2 --durations=25
 
 test-slow: venv
 	$(BIN)/python -m pytest -q -m slow
