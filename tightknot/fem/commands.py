@@ -203,7 +203,7 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
         return _fail("--figure draws the soft scenes' profiles: it cannot go with --no-soft")
     if args.figure is not None and not args.figure.endswith(".png"):
         return _fail(f"--figure must name a .png file, got {args.figure!r}")
-    if args.figure is not None and getattr(args, "draw_profiles", None) is None:
+    if args.figure is not None and args.draw_profiles is None:
         return _fail("--figure: this command line has no figures (tightknot[fem] without "
                      "its drawing)")
     try:

@@ -78,17 +78,19 @@ def along_contact(reference: list[dict[str, float]], other: list[dict[str, float
     contact = (mine[WIDTH_KEY] > 0.0) | (theirs[WIDTH_KEY] > 0.0)
     if not contact.any():
         return None
-    d_width = theirs[WIDTH_KEY][contact] - mine[WIDTH_KEY][contact]
-    d_area = theirs[AREA_KEY][contact] - mine[AREA_KEY][contact]
     sc = s[contact]
+    mine = {k: v[contact] for k, v in mine.items()}
+    theirs = {k: v[contact] for k, v in theirs.items()}
+    d_width = theirs[WIDTH_KEY] - mine[WIDTH_KEY]
+    d_area = theirs[AREA_KEY] - mine[AREA_KEY]
     iw, ia = int(np.argmax(np.abs(d_width))), int(np.argmax(np.abs(d_area)))
     rows = [{"s_over_d0": float(sc[j]),
-             "reference_area_ratio": float(mine[AREA_KEY][contact][j]),
-             "other_area_ratio": float(theirs[AREA_KEY][contact][j]),
-             "reference_contact_fraction": float(mine[WIDTH_KEY][contact][j]),
-             "other_contact_fraction": float(theirs[WIDTH_KEY][contact][j]),
-             "reference_peak_pressure_over_e": float(mine[PRESSURE_KEY][contact][j]),
-             "other_peak_pressure_over_e": float(theirs[PRESSURE_KEY][contact][j]),
+             "reference_area_ratio": float(mine[AREA_KEY][j]),
+             "other_area_ratio": float(theirs[AREA_KEY][j]),
+             "reference_contact_fraction": float(mine[WIDTH_KEY][j]),
+             "other_contact_fraction": float(theirs[WIDTH_KEY][j]),
+             "reference_peak_pressure_over_e": float(mine[PRESSURE_KEY][j]),
+             "other_peak_pressure_over_e": float(theirs[PRESSURE_KEY][j]),
              "width_fraction": float(d_width[j]), "area_points": float(d_area[j])}
             for j in range(sc.size)]
     return {
@@ -101,10 +103,10 @@ def along_contact(reference: list[dict[str, float]], other: list[dict[str, float
         "area_points_at_s_over_d0": float(sc[ia]),
         "contact_end_reference_over_d0": _loaded_end(ref),
         "contact_end_other_over_d0": _loaded_end(oth),
-        "reference_width_fraction_peak": float(mine[WIDTH_KEY][contact].max()),
-        "other_width_fraction_peak": float(theirs[WIDTH_KEY][contact].max()),
-        "reference_area_ratio_min": float(mine[AREA_KEY][contact].min()),
-        "other_area_ratio_min": float(theirs[AREA_KEY][contact].min()),
+        "reference_width_fraction_peak": float(mine[WIDTH_KEY].max()),
+        "other_width_fraction_peak": float(theirs[WIDTH_KEY].max()),
+        "reference_area_ratio_min": float(mine[AREA_KEY].min()),
+        "other_area_ratio_min": float(theirs[AREA_KEY].min()),
         "rows": rows,
     }
 

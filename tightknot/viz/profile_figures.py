@@ -56,7 +56,8 @@ def plot_soft_profiles(soft: Mapping[str, Any], level: str,
     if level not in soft.get("levels", {}):
         raise ValueError(f"the report's soft scenes hold no contact level {level!r} "
                          f"(it has {sorted(soft.get('levels', {}))})")
-    scenes = [s for s in SCENES if _compared(soft, level, s)]
+    compared = {s: _compared(soft, level, s) for s in SCENES}
+    scenes = [s for s in SCENES if compared[s]]
     if not scenes:
         raise ValueError("the report's soft scenes hold no compared level with profiles")
     fig, axes = plt.subplots(len(scenes), len(QUANTITIES), squeeze=False,
@@ -64,7 +65,7 @@ def plot_soft_profiles(soft: Mapping[str, Any], level: str,
     cmap = plt.get_cmap("viridis")
     for i, scene in enumerate(scenes):
         title, load_label = SCENES[scene]
-        steps = _compared(soft, level, scene)
+        steps = compared[scene]
         ends = [max((_s(row) for row in prof if row["contact_fraction"] > 0.0),
                     default=0.0) for _, f, r in steps for prof in (f["profile_a"],
                                                                    r["profile_a"])]
