@@ -5,7 +5,7 @@ import pytest
 
 @pytest.fixture(scope="session")
 def squeeze_plane_strain_convergence():
-    """Plane-strain squeeze, coarse mesh plus the three-mesh table (about 10 s)."""
+    """Plane-strain squeeze, coarse mesh plus the three-mesh table (about 13 s)."""
     pytest.importorskip("felupe")
     from tightknot.fem import run_scene
 
@@ -14,7 +14,7 @@ def squeeze_plane_strain_convergence():
 
 @pytest.fixture(scope="session")
 def indent_coarse():
-    """Indent on the coarse mesh (1080 hexahedra, about 15 s on 2 cores)."""
+    """Indent on the coarse mesh (1080 hexahedra, about 10 s)."""
     pytest.importorskip("felupe")
     from tightknot.fem import run_scene
 
@@ -23,7 +23,7 @@ def indent_coarse():
 
 @pytest.fixture(scope="session")
 def wrap_coarse():
-    """Wrap on the coarse mesh (960 hexahedra, 6 tension levels, 30 to 40 s on 2 cores)."""
+    """Wrap on the coarse mesh (960 hexahedra, 6 tension levels, about 20 s)."""
     pytest.importorskip("felupe")
     from tightknot.fem import run_scene
 
@@ -33,7 +33,7 @@ def wrap_coarse():
 @pytest.fixture(scope="session")
 def soft_squeeze_coarse():
     """Two soft rods pressed together (barrier contact), coarse, 4 levels, with the
-    rigid-plane squeeze on the same mesh (about 4 s on 2 cores)."""
+    rigid-plane squeeze on the same mesh (about 4 s)."""
     pytest.importorskip("felupe")
     pytest.importorskip("ipctk")
     from tightknot.fem import run_scene
@@ -55,7 +55,7 @@ def soft_crossing_coarse():
 @pytest.fixture(scope="session")
 def soft_wrap_one_level():
     """A soft rod pulled around a soft rod: one coarse level at T = 0.0069 E D0^2 (the
-    wrap's first level), no rigid run (about 100 s on 2 shared cores)."""
+    wrap's first level), no rigid run (about 30 s)."""
     pytest.importorskip("felupe")
     pytest.importorskip("ipctk")
     from tightknot.fem import run_scene
@@ -67,7 +67,7 @@ def soft_wrap_one_level():
 @pytest.fixture(scope="session")
 def soft_crossing_one_level():
     """Two soft rods crossing: one coarse level at w = 0.0375 D0 per rod (the scene's
-    second level), no rigid run."""
+    second level), no rigid run (about 40 s)."""
     pytest.importorskip("felupe")
     pytest.importorskip("ipctk")
     from tightknot.fem import run_scene
@@ -80,7 +80,7 @@ def soft_crossing_one_level():
 def clasp_one_level():
     """The clasp: relaxation in the clamps and one coarse level at a pull of 0.7 D0 (the
     FEM's bends touch from about 0.4 D0 on, the rod model's, clamped at the same points,
-    from about 0.55 D0; about 60 s on 2 shared cores)."""
+    from about 0.55 D0; about 85 s)."""
     pytest.importorskip("felupe")
     pytest.importorskip("ipctk")
     from tightknot.fem import run_scene

@@ -1,6 +1,11 @@
 """The FEM's sparse symmetric solvers (tightknot.fem.linsolve): every installed library
 solves definite and indefinite systems, the choice is checked, SuperLU is the fallback."""
 
+import glob
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -69,3 +74,30 @@ def test_a_bad_solution_falls_back_to_superlu(monkeypatch):
     b = np.arange(k.shape[0], dtype=float)
     x = linsolve.solve_symmetric(k, b, "pardiso")
     assert np.linalg.norm(k @ x - b) <= 1e-12 * np.linalg.norm(b)
+
+
+@pytest.mark.skipif(not glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")),
+                    reason="MKL's runtime is not the environment's mkl wheel")
+def test_pardiso_solves_do_not_search_the_environment_for_mkl():
+    # pypardiso builds a solver per solve here and, unless told where MKL's runtime is,
+    # each walks the whole environment for it (0.6 s a solve, ten times a coarse FEM
+    # scene's own work): the FEM points it at the wheel's library once
+    code = (
+        "import glob, os, sys\n"
+        "calls = []\n"
+        "walk = glob.glob\n"
+        "glob.glob = lambda p, *a, **k: (calls.append(p), walk(p, *a, **k))[1]\n"
+        "import numpy as np, scipy.sparse as sp\n"
+        "from tightknot.fem import linsolve\n"
+        "k = sp.diags([2.0, 3.0, 4.0]).tocsc()\n"
+        "for _ in range(2):\n"
+        "    x = linsolve.solve_symmetric(k, np.ones(3), 'pardiso')\n"
+        "assert np.allclose(x, [1 / 2, 1 / 3, 1 / 4])\n"
+        "print(sum('**' in p for p in calls), os.environ['PYPARDISO_MKL_RT'])\n")
+    env = {k: v for k, v in os.environ.items() if k != "PYPARDISO_MKL_RT"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env=env)
+    searches, path = out.stdout.split()
+    assert searches == "0"
+    assert os.path.samefile(path, sorted(glob.glob(os.path.join(sys.prefix, "lib",
+                                                                "libmkl_rt.so*")))[0])

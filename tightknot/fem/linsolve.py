@@ -30,6 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from tightknot.solvers.pardiso import point_pypardiso_at_mkl
+
 SOLVERS: tuple[str, ...] = ("auto", "pardiso", "cholmod", "superlu")
 """Names of the linear solvers ("auto": the fastest installed one)."""
 
@@ -56,6 +58,7 @@ def default_solver() -> str:
 
 @cache
 def _pardiso_ok() -> bool:
+    point_pypardiso_at_mkl()
     try:
         import pypardiso
 
@@ -113,6 +116,7 @@ def _superlu(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 def _pardiso(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
     import pypardiso
 
+    point_pypardiso_at_mkl()  # a solver is built per solve: without it, each searches
     solver = pypardiso.PyPardisoSolver(mtype=-2)  # real symmetric indefinite
     upper = sp.triu(k, format="csr")  # PARDISO reads the upper triangle of a symmetric type
     upper.sort_indices()

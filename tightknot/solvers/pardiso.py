@@ -45,21 +45,40 @@ SOLVERS = ("auto", "pardiso", "superlu")
 
 
 @cache
+def mkl_runtime_path() -> str | None:
+    """The path of MKL's runtime library ``libmkl_rt.so*`` that the ``mkl`` wheel puts in
+    the environment's lib/ and that loads here; None where there is none (pypardiso may
+    still find one elsewhere)."""
+    # pypardiso looks for MKL in every PyPardisoSolver it builds, by walking the whole
+    # environment when ctypes.util.find_library does not know the wheel's library (most
+    # of a second each time); the wheel's library sits in lib/.
+    for path in sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*"))):
+        try:
+            ctypes.CDLL(path)
+        except OSError:
+            continue
+        return path
+    return None
+
+
+def point_pypardiso_at_mkl() -> None:
+    """Tell pypardiso where MKL's runtime is (its ``PYPARDISO_MKL_RT``), unless the
+    environment already does, so that each of its solvers loads it without a search."""
+    path = mkl_runtime_path()
+    if path is not None:
+        os.environ.setdefault("PYPARDISO_MKL_RT", path)
+
+
+@cache
 def _library() -> ctypes.CDLL | None:
     """MKL's runtime (the ``mkl`` wheel's, else where pypardiso finds it), with the
     pardiso entry point typed; None when pypardiso or MKL is not installed."""
     # pypardiso's presence says MKL's (the supported way in); it is found, not imported:
-    # its import builds a solver whose search for MKL walks the whole environment (most of
-    # a second per process), while the wheel's library sits in the environment's lib/.
+    # its import builds a solver, whose search for MKL :func:`mkl_runtime_path` spares.
     if importlib.util.find_spec("pypardiso") is None:
         return None
-    lib = None
-    for path in sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*"))):
-        try:
-            lib = ctypes.CDLL(path)
-            break
-        except OSError:
-            continue
+    path = mkl_runtime_path()
+    lib = None if path is None else ctypes.CDLL(path)
     if lib is None:
         try:
             import pypardiso
