@@ -44,7 +44,7 @@ def soft_squeeze_coarse():
 @pytest.fixture(scope="session")
 def soft_crossing_coarse():
     """Two soft rods crossing at 90 degrees, coarse, 4 levels, with the rigid indent
-    (about 500 s on 2 shared cores: slow tests only)."""
+    (about 3 min: slow tests only)."""
     pytest.importorskip("felupe")
     pytest.importorskip("ipctk")
     from tightknot.fem import run_scene

@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("felupe")
 pytest.importorskip("ipctk")
 
-SLOW = pytest.mark.slow  # the coarse scene's 4 levels: about 500 s on 2 shared cores
+SLOW = pytest.mark.slow  # the coarse scene's 4 levels and the rigid indent: about 3 min
 
 
 @pytest.fixture(scope="module")
