@@ -58,6 +58,8 @@ def default_solver() -> str:
 
 @cache
 def _pardiso_ok() -> bool:
+    # every solve passes here first (resolve): pypardiso, which builds a solver per solve,
+    # then loads MKL's runtime from where it is told instead of searching for it each time
     point_pypardiso_at_mkl()
     try:
         import pypardiso
@@ -116,7 +118,6 @@ def _superlu(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 def _pardiso(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
     import pypardiso
 
-    point_pypardiso_at_mkl()  # a solver is built per solve: without it, each searches
     solver = pypardiso.PyPardisoSolver(mtype=-2)  # real symmetric indefinite
     upper = sp.triu(k, format="csr")  # PARDISO reads the upper triangle of a symmetric type
     upper.sort_indices()

@@ -50,8 +50,8 @@ def mkl_runtime_path() -> str | None:
     the environment's lib/ and that loads here; None where there is none (pypardiso may
     still find one elsewhere)."""
     # pypardiso looks for MKL in every PyPardisoSolver it builds, by walking the whole
-    # environment when ctypes.util.find_library does not know the wheel's library (most
-    # of a second each time); the wheel's library sits in lib/.
+    # environment when ctypes.util.find_library does not know the wheel's library; the
+    # wheel's library sits in lib/.
     for path in sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*"))):
         try:
             ctypes.CDLL(path)
