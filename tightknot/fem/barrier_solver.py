@@ -36,7 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .barrier import BarrierContact
-from .linsolve import default_solver, solve_symmetric
+from .linsolve import SymmetricSolver, default_solver
 
 
 class BarrierNewtonFailure(RuntimeError):
@@ -78,6 +78,8 @@ class BarrierProblem:
     intermediate_tol: float = 1e-4
     external: Callable[[float], np.ndarray] | None = None
     linear_solver: str = field(default_factory=default_solver)
+    _linear: SymmetricSolver | None = field(default=None, init=False, repr=False,
+                                            compare=False)
 
     @property
     def u(self) -> np.ndarray:
@@ -150,7 +152,10 @@ class BarrierProblem:
         free = ~self.fixed
         k_ff = k[free][:, free].tocsc()
         du = np.zeros(self.fixed.size)
-        du[free] = solve_symmetric(k_ff, rhs, self.linear_solver)
+        if self._linear is None or self._linear.requested != self.linear_solver:
+            # one per problem: PARDISO's analysis is kept while the tangent's pattern stays
+            self._linear = SymmetricSolver(self.linear_solver)
+        du[free] = self._linear(k_ff, rhs)
         if not np.all(np.isfinite(du)):
             raise BarrierNewtonFailure("non-finite Newton step (singular tangent)")
         return du

@@ -5,10 +5,13 @@ and mostly positive definite, but not always: the solid's tangent under contact 
 exact (unprojected) barrier Hessian can be indefinite (docs/fem_nip.md). The solvers, in
 the order ``"auto"`` tries them:
 
-- ``"pardiso"``: Intel MKL PARDISO through ``pypardiso`` (pip: ``pypardiso`` and the
-  ``mkl`` wheel; x86_64 only), matrix type -2 (real symmetric indefinite: supernodal
-  Bunch-Kaufman LDL^T with pivot perturbation and iterative refinement, Schenk & Gaertner,
-  FGCS 20 (2004) 475), so it takes the indefinite tangents too.
+- ``"pardiso"``: Intel MKL PARDISO (:class:`tightknot.solvers.pardiso.PardisoDirect`; pip:
+  ``pypardiso`` and the ``mkl`` wheel, x86_64 only), matrix type -2 (real symmetric
+  indefinite: supernodal Bunch-Kaufman LDL^T with pivot perturbation and iterative
+  refinement, Schenk & Gaertner, FGCS 20 (2004) 475), so it takes the indefinite tangents
+  too. A :class:`SymmetricSolver` keeps PARDISO's ordering and symbolic analysis from one
+  solve to the next while the tangent's pattern stays (a Newton loop's iterations between
+  changes of the contact set), so that such solves pay the numeric factorization only.
 - ``"cholmod"``: CHOLMOD's supernodal Cholesky through ``scikit-sparse`` (Chen, Davis,
   Hager & Rajamanickam, ACM TOMS 35 (2008) 22), METIS ordering. It needs SuiteSparse's
   headers to build (Debian: ``libsuitesparse-dev``; PyPI has no wheel), and a positive
@@ -18,7 +21,8 @@ the order ``"auto"`` tries them:
 
 Every solution is checked: a relative residual above ``RESIDUAL_TOL`` (a perturbed pivot
 that refinement did not repair) falls back to SuperLU. The environment variable
-``TIGHTKNOT_FEM_SOLVER`` sets the default (one of :data:`SOLVERS`).
+``TIGHTKNOT_FEM_SOLVER`` sets the default (one of :data:`SOLVERS`). PARDISO runs on MKL's
+own thread count here (``MKL_NUM_THREADS``, else the cores), unlike the rod's one thread.
 """
 
 from __future__ import annotations
@@ -30,7 +34,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from tightknot.solvers.pardiso import point_pypardiso_at_mkl
+from tightknot.solvers.pardiso import PardisoDirect
+from tightknot.solvers.pardiso import available as pardiso_available
 
 SOLVERS: tuple[str, ...] = ("auto", "pardiso", "cholmod", "superlu")
 """Names of the linear solvers ("auto": the fastest installed one)."""
@@ -57,20 +62,6 @@ def default_solver() -> str:
 
 
 @cache
-def _pardiso_ok() -> bool:
-    # every solve passes here first (resolve): pypardiso, which builds a solver per solve,
-    # then loads MKL's runtime from where it is told instead of searching for it each time
-    point_pypardiso_at_mkl()
-    try:
-        import pypardiso
-
-        pypardiso.PyPardisoSolver()  # finds MKL's runtime library or raises ImportError
-    except (ImportError, OSError):
-        return False
-    return True
-
-
-@cache
 def _cholmod_ok() -> bool:
     try:
         import sksparse.cholmod  # noqa: F401
@@ -81,7 +72,7 @@ def _cholmod_ok() -> bool:
 
 def available() -> tuple[str, ...]:
     """The solvers installed here, fastest first ("superlu" always)."""
-    return tuple(n for n, ok in (("pardiso", _pardiso_ok()), ("cholmod", _cholmod_ok()),
+    return tuple(n for n, ok in (("pardiso", pardiso_available()), ("cholmod", _cholmod_ok()),
                                  ("superlu", True)) if ok)
 
 
@@ -115,18 +106,6 @@ def _superlu(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
     return splu(k).solve(rhs)
 
 
-def _pardiso(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
-    import pypardiso
-
-    solver = pypardiso.PyPardisoSolver(mtype=-2)  # real symmetric indefinite
-    upper = sp.triu(k, format="csr")  # PARDISO reads the upper triangle of a symmetric type
-    upper.sort_indices()
-    try:
-        return np.asarray(solver.solve(upper, rhs)).ravel()
-    finally:
-        solver.free_memory(everything=True)
-
-
 def _cholmod(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray | None:
     from sksparse.cholmod import CholmodNotPositiveDefiniteError, cholesky
 
@@ -136,19 +115,49 @@ def _cholmod(k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray | None:
         return None  # indefinite: the caller falls back to SuperLU
 
 
+class SymmetricSolver:
+    """Solves a sequence of sparse symmetric systems K x = rhs [any units] (a Newton loop's
+    tangents) by ``solver`` (one of :data:`SOLVERS`, default :func:`default_solver`), with
+    SuperLU where the chosen library cannot (indefinite K for CHOLMOD) or its residual is
+    above :data:`RESIDUAL_TOL`. With PARDISO the analysis of the last pattern is kept.
+
+    Attributes:
+        requested: ``solver`` as given; name: the library that solves (:func:`resolve`).
+    """
+
+    def __init__(self, solver: str | None = None) -> None:
+        self.requested = solver
+        self.name = resolve(solver)
+        self._pardiso: PardisoDirect | None = None
+
+    @property
+    def analyses(self) -> int:
+        """PARDISO's symbolic analyses so far (0 for the other libraries)."""
+        return 0 if self._pardiso is None else self._pardiso.analyses
+
+    def __call__(self, k: sp.spmatrix, rhs: np.ndarray) -> np.ndarray:
+        """x with K x = rhs."""
+        k = sp.csc_matrix(k)
+        rhs = np.asarray(rhs, dtype=float)
+        x = None
+        if self.name == "pardiso":
+            x = self._solve_pardiso(k, rhs)
+        elif self.name == "cholmod":
+            x = _cholmod(k, rhs)
+        if _accurate(k, x, rhs):
+            return x
+        return _superlu(k, rhs)
+
+    def _solve_pardiso(self, k: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray | None:
+        if self._pardiso is None:
+            # indefinite tangents are solved as they are (the Newton loops test descent)
+            self._pardiso = PardisoDirect(convex=False, threads=None)
+        solve = self._pardiso.factor(k)
+        return None if solve is None else solve(rhs)
+
+
 def solve_symmetric(k: sp.spmatrix, rhs: np.ndarray, solver: str | None = None
                     ) -> np.ndarray:
-    """x with K x = rhs for a symmetric sparse K [any units], by ``solver`` (one of
-    :data:`SOLVERS`, default :func:`default_solver`); SuperLU where the chosen library
-    cannot (indefinite K for CHOLMOD) or its residual is above :data:`RESIDUAL_TOL`."""
-    k = sp.csc_matrix(k)
-    rhs = np.asarray(rhs, dtype=float)
-    name = resolve(solver)
-    x = None
-    if name == "pardiso":
-        x = _pardiso(k, rhs)
-    elif name == "cholmod":
-        x = _cholmod(k, rhs)
-    if _accurate(k, x, rhs):
-        return x
-    return _superlu(k, rhs)
+    """x with K x = rhs for one symmetric sparse K [any units] (:class:`SymmetricSolver`,
+    nothing kept)."""
+    return SymmetricSolver(solver)(k, rhs)

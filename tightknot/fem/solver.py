@@ -3,7 +3,7 @@
 Displacement control: every load parameter moves the rigid surfaces (all Dirichlet
 conditions are homogeneous symmetry or end conditions), Newton's method solves for the
 displacements, and a failed increment is cut back (halved) from the last checkpoint.
-The sparse symmetric system is solved by :func:`tightknot.fem.linsolve.solve_symmetric`
+The sparse symmetric system is solved by :class:`tightknot.fem.linsolve.SymmetricSolver`
 (MKL PARDISO where installed, else SuperLU with diagonal pivoting off and the symmetric
 mode on).
 """
@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .contact import PenaltyContact
-from .linsolve import solve_symmetric
+from .linsolve import SymmetricSolver
 
 
 class NewtonFailure(RuntimeError):
@@ -46,6 +46,8 @@ class Problem:
     iterations: list[int] = field(default_factory=list)
     external: np.ndarray | None = None
     max_backtracks: int = 0
+    _linear: SymmetricSolver | None = field(default=None, init=False, repr=False,
+                                            compare=False)
 
     @property
     def mesh(self) -> Any:
@@ -122,7 +124,9 @@ class Problem:
             scale = max(reaction, 1e-3 * self.force_scale)
             k_free = k[free][:, free].tocsc()
             du = np.zeros_like(r)
-            du[free] = -solve_symmetric(k_free, r_free)
+            if self._linear is None:  # one per problem: its analysis is kept between solves
+                self._linear = SymmetricSolver()
+            du[free] = -self._linear(k_free, r_free)
             if not np.all(np.isfinite(du)):
                 raise NewtonFailure("non-finite correction")
             if self.max_backtracks > 0:

@@ -17,9 +17,11 @@ loop raises its shift until it steps on a convex model (inertia correction).
 
 PARDISO runs on one thread here: its result then does not depend on the thread count
 (MKL's conditional numerical reproducibility), and the workers of a sweep or a test run
-each have a core. ``pypardiso`` (BSD) loads MKL's runtime (the ``mkl`` wheel, x86_64 only;
-both in the ``pardiso`` and ``fem`` extras); without it the sectioned level solves with
-SuperLU as the others do (:class:`tightknot.solvers.linear.SparseDirect`).
+each have a core. The FEM's Newton loops (:mod:`tightknot.fem.linsolve`) keep the analysis
+the same way on MKL's own thread count. ``pypardiso`` (BSD) comes with MKL's runtime (the
+``mkl`` wheel, x86_64 only; both in the ``pardiso`` and ``fem`` extras); without it the
+sectioned level solves with SuperLU as the others do
+(:class:`tightknot.solvers.linear.SparseDirect`).
 """
 
 from __future__ import annotations
@@ -59,14 +61,6 @@ def mkl_runtime_path() -> str | None:
             continue
         return path
     return None
-
-
-def point_pypardiso_at_mkl() -> None:
-    """Tell pypardiso where MKL's runtime is (its ``PYPARDISO_MKL_RT``), unless the
-    environment already does, so that each of its solvers loads it without a search."""
-    path = mkl_runtime_path()
-    if path is not None:
-        os.environ.setdefault("PYPARDISO_MKL_RT", path)
 
 
 @cache
@@ -126,8 +120,9 @@ def section_linear() -> SparseDirect:
 class _Handle:
     """One PARDISO instance (its internal memory ``pt``), freed with the object."""
 
-    def __init__(self, lib: ctypes.CDLL) -> None:
+    def __init__(self, lib: ctypes.CDLL, threads: int | None = 1) -> None:
         self.lib = lib
+        self.threads = threads
         self.pt = np.zeros(64, dtype=np.int64)
         self.iparm = np.zeros(64, dtype=np.int32)
         ip = self.iparm
@@ -144,8 +139,10 @@ class _Handle:
     def call(self, phase: int, a: sp.csr_matrix, perm: np.ndarray, b: np.ndarray,
              x: np.ndarray) -> int:
         """PARDISO ``phase`` on the upper triangle ``a``; its error code (0: none)."""
-        # one thread for this call only (a thread-local setting, restored after it)
-        previous = self.lib.MKL_Set_Num_Threads_Local(1)
+        if self.threads is None:  # MKL's own setting (MKL_NUM_THREADS, else the cores)
+            return _pardiso(self.lib, self.pt, self.iparm, phase, a, perm, b, x)
+        # the thread count for this call only (a thread-local setting, restored after it)
+        previous = self.lib.MKL_Set_Num_Threads_Local(self.threads)
         try:
             return _pardiso(self.lib, self.pt, self.iparm, phase, a, perm, b, x)
         finally:
@@ -198,6 +195,8 @@ class PardisoDirect(SparseDirect):
             that the Newton loop raises its shift until the model it steps on is convex
             (inertia correction, Waechter & Biegler 2006); False: return the direction
             of an indefinite matrix too, as SuperLU does.
+        threads: MKL threads per PARDISO call (default one: see the module docstring);
+            None leaves MKL's own setting.
     """
 
     name = "pardiso"
@@ -206,11 +205,11 @@ class PardisoDirect(SparseDirect):
     #: (a kept ordering of a denser pattern fills in more).
     REORDER_GROWTH = 0.1
 
-    def __init__(self, convex: bool = True) -> None:
+    def __init__(self, convex: bool = True, threads: int | None = 1) -> None:
         lib = _library()
         if lib is None:
             raise ImportError("MKL PARDISO is not installed (pypardiso and mkl)")
-        self._h = _Handle(lib)
+        self._h = _Handle(lib, threads)
         self._key: tuple | None = None
         self._upper_of: tuple | None = None
         self._perm = np.zeros(0, dtype=np.int32)
@@ -231,6 +230,12 @@ class PardisoDirect(SparseDirect):
         self.refused_indefinite = False
         return shifted_solve(h, g, mu, diag,
                              lambda b, m, dg: self._factorize(b, m, dg, convex))
+
+    def factor(self, matrix: sp.spmatrix) -> Callable[[np.ndarray], np.ndarray] | None:
+        """The solution operator of the symmetric sparse ``matrix`` (its analysis kept from
+        the last call while the pattern is the same); None where PARDISO fails, or (with
+        ``convex``) where the matrix has a negative eigenvalue."""
+        return self._factorize(matrix, 0.0, np.zeros(0), self._convex)
 
     def _upper(self, base: sp.spmatrix) -> tuple:
         """The upper triangle of the symmetric ``base`` in CSR, read from its lower one in
