@@ -26,9 +26,9 @@ from tightknot.fem.crosscheck import (  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def report(indent_coarse, wrap_coarse):
-    return crosscheck("coarse", fem_results={"indent": indent_coarse, "wrap": wrap_coarse},
-                      soft=False)
+def report(indent_coarse, wrap_coarse, once_per_run):
+    return once_per_run("crosscheck_report", lambda: crosscheck(
+        "coarse", fem_results={"indent": indent_coarse, "wrap": wrap_coarse}, soft=False))
 
 
 def test_default_mesh_is_the_calibration_mesh():
