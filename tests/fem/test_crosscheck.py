@@ -224,6 +224,27 @@ def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
     assert sec["fem_wall_time_s"] == report["fem_wall_time_s"]  # the same FEM runs
     assert all(lv["rod_converged"] for s in sec["scenes"].values()
                for lv in s["comparison"]["levels"])
+    # indent and wrap along their contact (issue 18: L_c within 0.1 and A/A0 within 5
+    # points along the contact): both sides' profiles at every level, judged; on the
+    # coarse mesh the sectioned level meets both in the wrap (2026-12-08: within 0.051 and
+    # 2.9 points; the indent's L_c is missed by up to 0.139, reported, not asserted); the
+    # compliant level has no profile to compare
+    for name in ("indent", "wrap"):
+        comp = sec["scenes"][name]["comparison"]
+        for lv in comp["levels"]:
+            prof = lv["profile_a"]
+            assert prof["rows"][0]["s_over_d0"] == 0.0 and prof["layers"] >= 1
+            assert lv["met"]["width_profile_a"] == (prof["width_fraction_max"]
+                                                    <= TARGETS["width_fraction"])
+            assert lv["met"]["area_profile_a"] == (prof["area_points_max"]
+                                                   <= TARGETS["area_points"])
+        assert comp["worst"]["width_profile"] == max(
+            lv["profile_a"]["width_fraction_max"] for lv in comp["levels"])
+        assert not any("profile_a" in lv
+                       for lv in report["scenes"][name]["comparison"]["levels"])
+    wrap = sec["scenes"]["wrap"]["comparison"]
+    assert all(lv["met"]["width_profile_a"] and lv["met"]["area_profile_a"]
+               for lv in wrap["levels"])
     rows = {r["level"]: r for r in level_truth(report, None, sec)["rows"]}
     wc = [lv["width_fraction"] for s in sec["scenes"].values()
           for lv in s["comparison"]["levels"] if lv["width_fraction"] is not None]

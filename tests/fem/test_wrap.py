@@ -104,3 +104,16 @@ def test_wrap_mesh_convergence():
     for key in ("area_ratio_mid", "overlap_over_d0", "kappa_d0_mid"):
         diff = [abs(m["relative_difference_to_finest"][key]) for m in meshes]
         assert diff[0] > diff[1], key
+
+
+def test_profile_along_the_rod(wrap_coarse):
+    # A/A0, L_c and p/E per node layer (the soft scenes' profile, judged along the contact
+    # by the sectioned cross-check): the middle layer's area is the one reported there, and
+    # the contact is centred on the middle and ends within the rod
+    for st in wrap_coarse["steps"]:
+        prof = st["profile_a"]
+        assert prof[0]["s_over_d0"] == 0.0
+        assert prof[0]["area_ratio"] == pytest.approx(st["area_ratio_mid"], rel=1e-12)
+        lc = np.array([r["contact_fraction"] for r in prof])
+        assert np.all((lc >= 0.0) & (lc <= 1.0)) and lc[0] > 0.0 and lc[-1] == 0.0
+        assert prof[0]["peak_pressure_over_e"] > 0.0

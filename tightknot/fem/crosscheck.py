@@ -87,6 +87,7 @@ from .crosscheck_soft import (
     finer_columns,
     finer_mesh,
     finer_summary,
+    profile_columns,
     same_levels,
     spread_mesh,
 )
@@ -130,7 +131,10 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
     (:func:`fem_width_fraction` of that scene), None: not compared; ``spread_steps``: the
     same scene on the next coarser mesh at the same levels, whose difference from
     ``fem_steps`` each row reports as the FEM's own spread (``fem_spread_rel``:
-    :func:`~tightknot.fem.crosscheck_soft.fem_spread`; None without); ``finer_steps``:
+    :func:`~tightknot.fem.crosscheck_soft.fem_spread`; None without; with ``width_scene``,
+    where both steps hold the profile ``profile_a`` (the sectioned level), A/A0 and L_c are also
+    judged along the contact: :func:`~tightknot.fem.crosscheck_soft.profile_columns`, the
+    spread step's profile as the FEM's own spread); ``finer_steps``:
     the scene on the next finer mesh, where given
     (:func:`~tightknot.fem.crosscheck_soft.finer_columns`)."""
     fem_force, rod_force = force_keys
@@ -176,11 +180,24 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
                        else r["contact_width_fraction_mid"] - lc)
             row["met"]["width"] = (row["width_fraction"] is not None
                                    and abs(row["width_fraction"]) <= TARGETS["width_fraction"])
+        if width_scene is not None:
+            # along the contact, where both sides report a profile (the sectioned level)
+            row.update(profile_columns(width_scene, f, r, c))
+            prof = row.get("profile_a")
+            if prof is not None:
+                row["met"]["width_profile_a"] = (prof["width_fraction_max"]
+                                                 <= TARGETS["width_fraction"])
+                row["met"]["area_profile_a"] = (prof["area_points_max"]
+                                                <= TARGETS["area_points"])
         rows.append(row)
     worst = {k: max((abs(x[k]) for x in rows if x.get(k) is not None), default=None)
              for k in ("force_rel", "area_points", "pressure_rel")
              + (("curvature_rel",) if kappa_key is not None else ())
              + (("width_fraction",) if width_scene is not None else ())}
+    profiles = [x["profile_a"] for x in rows if x.get("profile_a") is not None]
+    if profiles:
+        worst["width_profile"] = max(p["width_fraction_max"] for p in profiles)
+        worst["area_profile_points"] = max(p["area_points_max"] for p in profiles)
     spreads = [abs(x["fem_spread_rel"]["force"]) for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
             "fem_force_spread_max": max(spreads, default=None),

@@ -320,9 +320,10 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
 
 
 #: Per scene: the rods whose profiles are compared along the contact (the clasp's U's and
-#: the crossing's rods are one another's images: A's only).
+#: the crossing's rods are one another's images: A's only; the rigid scenes' one rod).
 PROFILE_RODS: dict[str, tuple[str, ...]] = {"soft_wrap": ("a", "b"), "clasp": ("a",),
-                                            "soft_crossing": ("a",)}
+                                            "soft_crossing": ("a",), "wrap": ("a",),
+                                            "indent": ("a",)}
 
 
 def profile_columns(scene: str, fem: dict[str, Any], rod: dict[str, Any],

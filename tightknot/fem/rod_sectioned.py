@@ -41,6 +41,17 @@ def _report(layer: Any, system: Any) -> dict[str, np.ndarray]:
     return layer.section_report(st.x, st.extra, st.frames, system.rest)
 
 
+def _outward_profile(rep: dict[str, np.ndarray], verts: np.ndarray, h: float,
+                     diameter: float) -> list[dict[str, float]]:
+    """A/A0, L_c and p_max/E per vertex of ``verts`` (the middle first, then outward, rest
+    edge length ``h`` [m]) at rest arc length ``s_over_d0`` from the middle: the rows of
+    the FEM's ``profile_a`` (:mod:`tightknot.fem.profile_compare`)."""
+    return [{"s_over_d0": k * h / diameter, "area_ratio": float(rep["area_ratio"][u]),
+             "contact_fraction": float(rep["contact_width_fraction"][u]),
+             "peak_pressure_over_e": float(rep["peak_pressure_over_E"][u])}
+            for k, u in enumerate(verts)]
+
+
 def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
                          youngs_modulus: float = YOUNGS_MODULUS, length_over_d0: float = 3.0,
                          section: Any = None, edges_per_d0: int = EDGES_PER_D0,
@@ -49,7 +60,8 @@ def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
     level (``section``: its :class:`~tightknot.contact.sectioned.SectionSettings`;
     ``edges_per_d0`` and ``gauss_points`` per edge: the rod's resolution). Per
     level: ``force`` [N] on the upper indenter, ``area_ratio_mid``, ``peak_pressure_over_e``,
-    ``contact_width_fraction_mid`` (both indenters' contacts), ``axial_stretch_mid``."""
+    ``contact_width_fraction_mid`` (both indenters' contacts), ``axial_stretch_mid``;
+    ``profile_a``: A/A0, L_c and p_max/E per vertex from the middle outward."""
     start = time.perf_counter()
     d0 = diameter
     scene = indent_scene(diameter, youngs_modulus, length_over_d0,
@@ -75,6 +87,9 @@ def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "peak_pressure_over_e": float(rep["peak_pressure_over_E"][v]),
             "contact_width_fraction_mid": float(rep["contact_width_fraction"][v]),
             "contact_weight_sum_mean": rep["contact_weight_sum_mean"],
+            # from the middle outward, as the FEM's quarter rod (z >= 0) reports it
+            "profile_a": _outward_profile(rep, np.arange(v, rod_v0 + n_rod + 1),
+                                          2.0 * half / n_rod, d0),
         }
 
     rows = _solve_levels(system, load, list(w_levels), measure)
@@ -172,7 +187,9 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
     length) and
     ``contact_axial_over_across_mid`` (within +-0.5 D0: the largest axial part of a
     vertex's contact force over the largest part across: the edges' thinning pull, as the
-    traction of a frictionless contact is all across)."""
+    traction of a frictionless contact is all across); ``profile_a``: A/A0, L_c and
+    p_max/E per vertex from the middle outward (rest arc length ``s_over_d0``), the rows of
+    the FEM's ``profile_a``."""
     from tightknot.knots.curvature import bergou_curvature
 
     start = time.perf_counter()
@@ -241,6 +258,8 @@ def rod_wrap_sectioned(tension_levels: list[float], wrap_angle_deg: float = 90.0
             "force_per_length_mid_window_over_e_d0": f_win / (youngs_modulus * d0),
             "contact_axial_over_across_mid": (float(np.abs(axial[near_half]).max()) / top
                                               if top > 0.0 else 0.0),
+            # from the middle outward, as the FEM's half rod (z >= 0) reports it
+            "profile_a": _outward_profile(rep, rod_v[mid:], h, d0),
         }
 
     rows = _solve_levels(system, load, list(tension_levels), measure)

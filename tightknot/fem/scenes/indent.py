@@ -48,6 +48,7 @@ from ._common import (
     mesh_convergence,
     relative,
 )
+from ._sections import RodSections
 
 SECTION_POINTS: dict[str, int] = {"coarse": 7, "medium": 9, "fine": 11}
 """Points per edge n of the quarter section (3 (n - 1)^2 quads: 108, 192, 300)."""
@@ -126,7 +127,8 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
     bulk = BULK_MODULUS * mu / SHEAR_MODULUS
     section = quarter_disk(radius, SECTION_POINTS[level])
     half_length = 0.5 * length_over_d0 * diameter
-    body = extrude(section, axial_nodes(half_length, diameter, AXIAL_FINE_CELLS[level]))
+    z = axial_nodes(half_length, diameter, AXIAL_FINE_CELLS[level])
+    body = extrude(section, z)
     region = fem.RegionHexahedron(body)
     field = fem.FieldContainer([fem.Field(region, dim=3)])
     solid = nearly_incompressible_solid(field, mu=mu, bulk=bulk)
@@ -153,6 +155,8 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
     on_top = np.isclose(pts[candidates, 0], 0.0)  # generatrix x = 0 under the indenter
     on_mid = np.isclose(pts[candidates, 2], 0.0)  # mid cross-section z = 0
     mid_points = np.arange(section.npoints)
+    # the rod's sections layer by layer, the contact centre under the indenter
+    sections = RodSections.from_section(section, radius, np.array([0.0, radius]), z, 0)
 
     def apply(w: float) -> None:
         indenter.shift = np.array([0.0, -w, 0.0])
@@ -169,6 +173,8 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
         s_x, p_x = line_profile(contact, x, pressure, on_mid, axis=0)
         a_z, a_x = edge_position(s_z, p_z), edge_position(s_x, p_x)
         area = section_area(x[mid_points, :2], section.cells)
+        p_all = np.zeros(body.npoints)
+        p_all[contact.points] = pressure
         return {
             "approach_over_d0": 2.0 * w / diameter,
             "w_over_d0": w / diameter,
@@ -183,6 +189,8 @@ def _run_one(level: str, max_approach_over_d0: float, steps: int, length_over_d0
             "axial_force_mid_over_e_d0sq": axial / (youngs_modulus * diameter**2),
             "volume_ratio": volume_ratio(solid),
             "newton_iterations": int(problem.iterations[-1]) if problem.iterations else 0,
+            # A/A0, L_c and p/E per node layer along the rod (the soft scenes' profile)
+            "profile_a": sections.profile(x, p_all, youngs_modulus, diameter),
         }
 
     loads = load_schedule(0.5 * max_approach_over_d0 * diameter, steps)

@@ -79,6 +79,7 @@ from ._common import (
     mesh_convergence,
     relative,
 )
+from ._sections import RodSections
 
 SECTION_POINTS: dict[str, int] = {"coarse": 5, "medium": 7, "fine": 9}
 """Points per edge n of each quarter of the half section (6 (n - 1)^2 quads: 96, 216, 384)."""
@@ -272,6 +273,8 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
     sec = np.asarray(section.points)
     i_bottom = int(np.argmin(np.hypot(sec[:, 0], sec[:, 1] + radius)))  # (0, -r)
     i_top = int(np.argmin(np.hypot(sec[:, 0], sec[:, 1] - radius)))  # (0, r)
+    # the rod's sections layer by layer, the contact centre on top (the cylinder's side)
+    sections = RodSections.from_section(section, radius, np.array([0.0, radius]), z, 0)
 
     def apply(tension: float) -> None:
         external[:] = np.outer(0.5 * tension * end_share, direction)
@@ -332,6 +335,8 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
                                          closed=False)[3])
         d_n = axis_y - nominal[0, 0]
         f_mid = float(line[0])
+        p_all = np.zeros(body.npoints)
+        p_all[contact.points] = pressure
         return {
             "tension": tension,
             "tension_over_e_d0sq": tension / (youngs_modulus * diameter**2),
@@ -362,6 +367,8 @@ def _run_one(level: str, max_tension_over_e_d0sq: float, steps: int, wrap_angle_
             "kappa_d0_mid_nominal": kappa_n * diameter,
             "volume_ratio": volume_ratio(solid),
             "newton_iterations": int(problem.iterations[-1]) if problem.iterations else 0,
+            # A/A0, L_c and p/E per node layer along the rod (the soft scenes' profile)
+            "profile_a": sections.profile(x, p_all, youngs_modulus, diameter),
             "profile": {
                 "z_rest_over_d0": z[:n_layers_fine] / diameter,
                 "centroid_yz_over_d0": cent[:, 1:] / diameter,
