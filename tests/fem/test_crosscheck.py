@@ -249,7 +249,12 @@ def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
     wc = [lv["width_fraction"] for s in sec["scenes"].values()
           for lv in s["comparison"]["levels"] if lv["width_fraction"] is not None]
     assert rows["sectioned"]["width_fraction_max"] == max(abs(w) for w in wc)
-    assert "| sectioned |" in format_table(level_truth(report, None, sec))
+    assert rows["sectioned"]["width_profile_max"] == max(
+        sec["scenes"][n]["comparison"]["worst"]["width_profile"] for n in ("indent", "wrap"))
+    assert rows["compliant"]["width_profile_max"] is None  # no profile at that level
+    text = format_table(level_truth(report, None, sec))
+    line = next(t for t in text.splitlines() if t.startswith("| sectioned |"))
+    assert "along the contact)" in line
     with pytest.raises(ValueError, match="sectioned level"):
         level_truth(report, None, report)
     # several sectioned reports, a row each (with and without the bend shift), and the

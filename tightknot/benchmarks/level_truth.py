@@ -50,6 +50,10 @@ def _scene_errors(scenes: dict[str, Any]) -> dict[str, Any]:
         "wrap_area_points_max": _max_abs(wr, "area_points"),
         "wrap_curvature_rel_max": _max_abs(wr, "curvature_rel"),
         "width_fraction_max": _max_abs(ind + wr, "width_fraction"),
+        # along the contact, where the report compares the profiles (the sectioned level)
+        "width_profile_max": max(
+            (w for w in (scenes[n]["comparison"].get("worst", {}).get("width_profile")
+                         for n in ("indent", "wrap")) if w is not None), default=None),
         "compared_levels": {"indent": len(ind), "wrap": len(wr)},
     }
 
@@ -164,7 +168,8 @@ def format_table(table: dict[str, Any]) -> str:
     lines = [f"contact levels against the FEM ({table['fem_mesh']} mesh, "
              f"{table['fem_wall_time_s']:.0f} s of FEM)",
              "| level | indent force | wrap line load | soft wrap line load | clasp force | "
-             "soft crossing force | area, max [points] | wrap curvature, max | L_c, max | "
+             "soft crossing force | area, max [points] | wrap curvature, max | "
+             "L_c, max (middle section) | "
              "clasp L_c along the contact, max | "
              "rod time [s] | FEM / rod time | knots' time / compliant |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -188,6 +193,8 @@ def format_table(table: dict[str, Any]) -> str:
             f"{100 * (row['wrap_curvature_rel_max'] or 0.0):.1f} % | "
             + ("n/a" if row["width_fraction_max"] is None
                else f"{row['width_fraction_max']:.2f}")
+            + ("" if row.get("width_profile_max") is None
+               else f" ({row['width_profile_max']:.2f} along the contact)")
             + (" | n/a" if soft.get("clasp_width_profile_max") is None
                else f" | {soft['clasp_width_profile_max']:.2f}")
             + f" | {row['rod_wall_time_s']:.2f} | {row['fem_over_rod_time_ratio']:.0f} | {kt} |")
