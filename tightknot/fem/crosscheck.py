@@ -87,7 +87,9 @@ from .crosscheck_soft import (
     finer_columns,
     finer_mesh,
     finer_summary,
+    judge_profiles,
     profile_columns,
+    profile_worst,
     same_levels,
     spread_mesh,
 )
@@ -183,21 +185,14 @@ def _compare(fem_steps: list[dict], rod_steps: list[dict], force_keys: tuple[str
         if width_scene is not None:
             # along the contact, where both sides report a profile (the sectioned level)
             row.update(profile_columns(width_scene, f, r, c))
-            prof = row.get("profile_a")
-            if prof is not None:
-                row["met"]["width_profile_a"] = (prof["width_fraction_max"]
-                                                 <= TARGETS["width_fraction"])
-                row["met"]["area_profile_a"] = (prof["area_points_max"]
-                                                <= TARGETS["area_points"])
+            judge_profiles(width_scene, row)
         rows.append(row)
     worst = {k: max((abs(x[k]) for x in rows if x.get(k) is not None), default=None)
              for k in ("force_rel", "area_points", "pressure_rel")
              + (("curvature_rel",) if kappa_key is not None else ())
              + (("width_fraction",) if width_scene is not None else ())}
-    profiles = [x["profile_a"] for x in rows if x.get("profile_a") is not None]
-    if profiles:
-        worst["width_profile"] = max(p["width_fraction_max"] for p in profiles)
-        worst["area_profile_points"] = max(p["area_points_max"] for p in profiles)
+    # only where profiles were compared: the other levels' reports keep their keys
+    worst.update({k: v for k, v in profile_worst(rows).items() if v is not None})
     spreads = [abs(x["fem_spread_rel"]["force"]) for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
             "fem_force_spread_max": max(spreads, default=None),

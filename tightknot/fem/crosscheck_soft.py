@@ -295,23 +295,14 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
                       "converged": row["rod_converged"]}
         if b_key is not None:
             row["met"]["area_b"] = abs(row["area_points_b"]) <= TARGETS["area_points"]
-        for rod in PROFILE_RODS[scene]:
-            prof = row.get(f"profile_{rod}")
-            if prof is not None:
-                row["met"][f"width_profile_{rod}"] = (prof["width_fraction_max"]
-                                                      <= TARGETS["width_fraction"])
-                row["met"][f"area_profile_{rod}"] = (prof["area_points_max"]
-                                                     <= TARGETS["area_points"])
+        judge_profiles(scene, row)
         if kappa_target:
             row["met"]["curvature"] = abs(row["curvature_rel"]) <= TARGETS["curvature_rel"]
         rows.append(row)
     worst = {k: max((abs(x[k]) for x in rows if x.get(k) is not None), default=None)
              for k in ("force_rel", "area_points", "area_points_b", "curvature_rel",
                        "pressure_rel")}
-    for key, name in (("width_profile", "width_fraction_max"),
-                      ("area_profile_points", "area_points_max")):
-        worst[key] = max((x[f"profile_{rod}"][name] for x in rows for rod in "ab"
-                          if x.get(f"profile_{rod}") is not None), default=None)
+    worst.update(profile_worst(rows))
     spreads = [x["fem_spread_rel"]["force"] for x in rows if x["fem_spread_rel"]]
     return {"levels": rows, "worst": worst,
             "fem_force_spread_max": max((abs(s) for s in spreads), default=None),
@@ -324,6 +315,28 @@ def compare(scene: str, fem_steps: list[dict], rod_steps: list[dict],
 PROFILE_RODS: dict[str, tuple[str, ...]] = {"soft_wrap": ("a", "b"), "clasp": ("a",),
                                             "soft_crossing": ("a",), "wrap": ("a",),
                                             "indent": ("a",)}
+
+
+def judge_profiles(scene: str, row: dict[str, Any]) -> None:
+    """Add to ``row["met"]`` the targets along the contact (L_c within
+    ``TARGETS["width_fraction"]``, A/A0 within ``TARGETS["area_points"]``) of each rod of
+    :data:`PROFILE_RODS` whose comparison (:func:`profile_columns`) the row holds."""
+    for rod in PROFILE_RODS[scene]:
+        prof = row.get(f"profile_{rod}")
+        if prof is not None:
+            row["met"][f"width_profile_{rod}"] = (prof["width_fraction_max"]
+                                                  <= TARGETS["width_fraction"])
+            row["met"][f"area_profile_{rod}"] = (prof["area_points_max"]
+                                                 <= TARGETS["area_points"])
+
+
+def profile_worst(rows: list[dict[str, Any]]) -> dict[str, float | None]:
+    """The largest L_c and A/A0 differences along the contact over the rows' profile
+    comparisons of both rods (``width_profile``, ``area_profile_points``; None without)."""
+    return {key: max((x[f"profile_{rod}"][name] for x in rows for rod in "ab"
+                      if x.get(f"profile_{rod}") is not None), default=None)
+            for key, name in (("width_profile", "width_fraction_max"),
+                              ("area_profile_points", "area_points_max"))}
 
 
 def profile_columns(scene: str, fem: dict[str, Any], rod: dict[str, Any],
