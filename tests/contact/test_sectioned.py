@@ -834,3 +834,33 @@ def test_on_a_straight_partner_the_passes_weights_sum_to_one() -> None:
     x_apart[25:, 1] += 2.0 * D0
     rep = layer.section_report(x_apart, np.zeros(layer.dof_count), st.frames, system.rest)
     assert rep["contact_weight_sum_mean"] is None
+
+
+def test_a_vertex_reports_the_largest_of_its_edges_circles() -> None:
+    # The report per vertex (the knots' maps, the mid rows of the cross-check) is the
+    # largest of the Gauss circles of the vertex's edges; the profiles along the contact
+    # read the circles at their own places (tightknot.fem.profile_compare.circle_profile).
+    # Two straight rods crossing between two of B's vertices, A pressed 0.03 D0 in.
+    mat = Material(1.25e6, 0.5, 1160.0)
+    b = RodBuilder(twist=False)
+    z = np.linspace(-1.5 * D0, 1.5 * D0, 25)
+    b.add_rod(np.c_[np.full(25, 0.3 * D0 / 12), np.zeros(25), z], D0, mat)
+    b.add_rod(np.c_[z, np.full(25, 0.97 * D0), np.zeros(25)], D0, mat)
+    model = b.finalize()
+    system = RodSystem(model, State.initial(model), BoundaryConditions(model))
+    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=64))
+    system.add_term(layer)
+    st = system.state
+    rep = layer.section_report(st.x, np.zeros(layer.dof_count), st.frames, system.rest)
+    width = rep["circle_contact_width_fraction"]
+    assert width.shape == rep["circle_peak_pressure_over_E"].shape == (model.edge_count, 2)
+    assert rep["circle_u"] == pytest.approx([0.5 - 0.5 / 3**0.5, 0.5 + 0.5 / 3**0.5])
+    assert np.array_equal(rep["edge_vertex"], model.edge_vertex)
+    assert np.count_nonzero(width) >= 4  # the contact spans several circles
+    for v in range(model.vertex_count):
+        edges = np.flatnonzero((model.edge_vertex == v).any(axis=1))
+        assert rep["contact_width_fraction"][v] == width[edges].max()
+        assert rep["peak_pressure_over_E"][v] == rep["circle_peak_pressure_over_E"][edges].max()
+    lam = (np.linalg.norm(np.diff(st.x[model.edge_vertex], axis=1)[:, 0], axis=1)
+           / system.rest)
+    assert rep["edge_area_ratio"] == pytest.approx(lam ** -1.0, rel=1e-12)

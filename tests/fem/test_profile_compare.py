@@ -1,9 +1,10 @@
 """Profiles along the contact, FEM against the rod model (tightknot.fem.profile_compare) and
 their place in the soft scenes' comparison (tightknot.fem.crosscheck_soft.compare)."""
 
+import numpy as np
 import pytest
 
-from tightknot.fem.profile_compare import along_contact, spread_summary
+from tightknot.fem.profile_compare import along_contact, circle_profile, spread_summary
 
 
 def _profile(s, width, area=None, pressure=None):
@@ -106,3 +107,36 @@ def test_the_soft_comparison_judges_the_profiles_along_the_contact():
     assert row["profile_a"]["fem_spread"] is None
     assert not bad["passed"]
     assert bad["worst"]["area_profile_points"] == pytest.approx(TARGETS["area_points"] + 0.01)
+
+
+def _circles():
+    # three edges 0-1, 2-1 (stored the other way round) and 2-3, two circles each, the
+    # values naming edge and circle (10 e + g)
+    width = np.array([[0.0, 1.0], [10.0, 11.0], [20.0, 21.0]])
+    return {"circle_contact_width_fraction": width,
+            "circle_peak_pressure_over_E": width + 100.0,
+            "edge_area_ratio": np.array([0.9, 0.8, 0.7]),
+            "circle_u": np.array([0.25, 0.75]),
+            "edge_vertex": np.array([[0, 1], [2, 1], [2, 3]])}
+
+
+def test_a_circle_profile_reads_each_circle_at_its_own_place_in_the_vertices_order():
+    rows = circle_profile(_circles(), np.array([0, 1, 2, 3]), np.array([0.0, 1.0, 2.0, 3.0]),
+                          2.0)
+    assert [r["s_over_d0"] for r in rows] == pytest.approx(
+        [0.125, 0.375, 0.625, 0.875, 1.125, 1.375])
+    # the edge stored from 2 to 1 gives its second circle (nearer vertex 1) first
+    assert [r["contact_fraction"] for r in rows] == [0.0, 1.0, 11.0, 10.0, 20.0, 21.0]
+    assert [r["peak_pressure_over_e"] for r in rows] == [100.0, 101.0, 111.0, 110.0, 120.0,
+                                                         121.0]
+    assert [r["area_ratio"] for r in rows] == [0.9, 0.9, 0.8, 0.8, 0.7, 0.7]
+    # read backwards, the same circles at the same places
+    back = circle_profile(_circles(), np.array([3, 2, 1, 0]), np.array([3.0, 2.0, 1.0, 0.0]),
+                          2.0)
+    assert sorted((r["s_over_d0"], r["contact_fraction"]) for r in back) == sorted(
+        (r["s_over_d0"], r["contact_fraction"]) for r in rows)
+
+
+def test_a_circle_profile_refuses_vertices_that_share_no_edge():
+    with pytest.raises(ValueError, match="share no edge"):
+        circle_profile(_circles(), np.array([0, 2]), np.array([0.0, 1.0]), 1.0)

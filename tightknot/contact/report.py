@@ -15,6 +15,10 @@ from tightknot.contact.layer import ContactLayer
 from tightknot.contact.sectioned import SectionedLayer
 from tightknot.rods.state import State
 
+#: The sectioned level's per-circle outputs a report carries (:attr:`ContactReport.circles`).
+CIRCLE_KEYS = ("circle_contact_width_fraction", "circle_peak_pressure_over_E",
+               "edge_area_ratio", "circle_u", "edge_vertex")
+
 
 @dataclass
 class ContactReport:
@@ -35,6 +39,10 @@ class ContactReport:
             inside of a partner bent tighter than rho kappa about 0.7;
             docs/sectioned_level.md, "The partner's partition of unity on a bent
             partner"); None at the other levels and without contact.
+        circles: the sectioned level's outputs per Gauss circle (the ``circle_...``,
+            ``edge_area_ratio`` and ``edge_vertex`` entries of
+            :meth:`~tightknot.contact.sectioned.SectionedLayer.section_report`); None at
+            the other levels.
     """
 
     overlap: np.ndarray
@@ -47,6 +55,7 @@ class ContactReport:
     area_ratio: np.ndarray
     pairs: np.ndarray
     weight_sum_mean: float | None = None
+    circles: dict[str, np.ndarray] | None = None
 
 
 def _segment_closest(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
@@ -168,6 +177,7 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
         area = law.area_factor(0.5 * (w1v + w2v), dv) / stretch_v
     force = f_line * emod
     weight_sum = None
+    circles = None
     if isinstance(layer, SectionedLayer):
         if state is None:
             raise ValueError("the sectioned contact level's report needs the state (its "
@@ -178,8 +188,9 @@ def contact_report(layer: ContactLayer, x: np.ndarray,
         p_mean, p_peak = sec["mean_pressure_over_E"], sec["peak_pressure_over_E"]
         force = sec["force_per_length"]
         weight_sum = sec["contact_weight_sum_mean"]
+        circles = {k: sec[k] for k in CIRCLE_KEYS}
     return ContactReport(
         overlap=2.0 * w1v, overlap_opposite=2.0 * w2v,
         force_per_length=force, half_width=half, contact_width_fraction=lc,
         mean_pressure_over_E=p_mean, peak_pressure_over_E=p_peak, area_ratio=area,
-        pairs=pair_list, weight_sum_mean=weight_sum)
+        pairs=pair_list, weight_sum_mean=weight_sum, circles=circles)

@@ -1097,7 +1097,13 @@ class SectionedLayer(ContactLayer):
           contacts sharing the width;
         * ``area_ratio``: A/A0 = lambda^(-2 nu), lambda the stretch of the vertex's edges
           (their rod's mean with ``thinning="rod"``; the modes keep the area,
-          docs/sectioned_level.md).
+          docs/sectioned_level.md);
+        * per Gauss circle, where the contact is evaluated: ``circle_contact_width_fraction``
+          and ``circle_peak_pressure_over_E`` (edges, circles), ``edge_area_ratio``
+          (edges,), ``circle_u`` (circles,: each circle's place along its edge, 0 at its
+          first vertex) and ``edge_vertex`` (edges, 2): a profile along a rod at the
+          circles' own places (:func:`tightknot.fem.profile_compare.circle_profile`), where
+          a vertex's value is the largest of the four circles within 0.79 of an edge of it.
         """
         m = self.model
         rest = np.asarray(rest, dtype=np.float64)
@@ -1168,7 +1174,12 @@ class SectionedLayer(ContactLayer):
                 "force_per_length_edges": f_len,
                 "contact_weight_sum_mean": weight_sum,
                 "half_width": 0.25 * math.pi * to_vertex(d0) * lc,
-                "area_ratio": stretch_v ** (-2.0 * nu_v)}
+                "area_ratio": stretch_v ** (-2.0 * nu_v),
+                "circle_contact_width_fraction": width,
+                "circle_peak_pressure_over_E": press.max(axis=2) / emod[:, None],
+                "edge_area_ratio": lam ** (-2.0 * self.edge_nu),
+                "circle_u": np.asarray(self.settings.gauss[0], dtype=np.float64),
+                "edge_vertex": ev}
 
     # -- the energy term -----------------------------------------------------------------
     def evaluate(self, x: np.ndarray, rest: np.ndarray, want_grad: bool = True,

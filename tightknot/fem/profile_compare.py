@@ -7,7 +7,10 @@ per rod as a list of rows (``s_over_d0``: rest arc length from the middle of the
 clasp's apex [D0], or ``z_over_d0`` along a straight rod; ``area_ratio`` A/A0;
 ``contact_fraction`` L_c; ``peak_pressure_over_e``): the FEM per node layer
 (:meth:`tightknot.fem.scenes._sections.RodSections.profile`), the rod
-model per vertex (:func:`tightknot.fem.rod_model_soft._profile`).
+model per vertex (:func:`tightknot.fem.rod_model_soft._profile`) or, at the sectioned level,
+per Gauss circle at the circle's own place (:func:`circle_profile`: a vertex's value is the
+largest of its edges' circles, which reach 0.79 of an edge from it, so that a vertex
+profile carries a contact's end outward by up to that much).
 
 :func:`along_contact` reads the second profile, linearly interpolated in s, at each layer
 of the first: the rod model against the FEM, or a coarser FEM mesh against the compared one
@@ -36,6 +39,36 @@ def arc_length(row: dict[str, float]) -> float:
     """A row's rest arc length [D0]: ``s_over_d0``, or ``z_over_d0`` along a straight rod
     (the FEM's soft crossing)."""
     return row["s_over_d0"] if "s_over_d0" in row else row["z_over_d0"]
+
+
+def circle_profile(circles: dict[str, np.ndarray], vertices: np.ndarray,
+                   s_rest: np.ndarray, diameter: float) -> list[dict[str, float]]:
+    """The sectioned level's profile at the Gauss circles of the edges that join
+    consecutive ``vertices`` of one rod (rest arc length ``s_rest`` [m] of each), from the
+    per-circle outputs ``circles`` of
+    :meth:`~tightknot.contact.sectioned.SectionedLayer.section_report`
+    (``circle_contact_width_fraction``, ``circle_peak_pressure_over_E``,
+    ``edge_area_ratio``, ``circle_u``, ``edge_vertex``): a row per circle at its rest arc
+    length [D0], in the order of ``vertices``."""
+    ev = np.asarray(circles["edge_vertex"])
+    edge_of = {(int(a), int(b)): e for e, (a, b) in enumerate(ev)}
+    rows = []
+    for (va, sa), (vb, sb) in zip(zip(vertices[:-1], s_rest[:-1], strict=True),
+                                  zip(vertices[1:], s_rest[1:], strict=True), strict=True):
+        e = edge_of.get((int(va), int(vb)))
+        us = np.asarray(circles["circle_u"], dtype=float)
+        order = np.arange(us.size)
+        if e is None:  # the edge runs from vb to va: its circles from va's end first
+            e = edge_of.get((int(vb), int(va)))
+            us, order = 1.0 - us[::-1], order[::-1]
+        if e is None:
+            raise ValueError(f"vertices {int(va)} and {int(vb)} share no edge")
+        for u, g in zip(us, order, strict=True):
+            rows.append({"s_over_d0": float(sa + u * (sb - sa)) / diameter,
+                         AREA_KEY: float(circles["edge_area_ratio"][e]),
+                         WIDTH_KEY: float(circles["circle_contact_width_fraction"][e, g]),
+                         PRESSURE_KEY: float(circles["circle_peak_pressure_over_E"][e, g])})
+    return rows
 
 
 def _columns(profile: list[dict[str, float]]) -> dict[str, np.ndarray]:

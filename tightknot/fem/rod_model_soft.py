@@ -100,6 +100,20 @@ def _profile(report: Any, vertices: np.ndarray, s_rest: np.ndarray,
             for v, s in zip(vertices, s_rest, strict=True)]
 
 
+def _along(report: Any, vertices: np.ndarray, s_rest: np.ndarray, diameter: float,
+           first: int) -> list[dict[str, float]]:
+    """The profile judged along the contact, from ``vertices[first]`` outward: at the
+    sectioned level per Gauss circle from the edge before it, so that s = 0 lies inside
+    (:func:`tightknot.fem.profile_compare.circle_profile`), else per vertex
+    (:func:`_profile`)."""
+    if report.circles is not None and first > 0:
+        from tightknot.fem.profile_compare import circle_profile
+
+        return circle_profile(report.circles, vertices[first - 1:], s_rest[first - 1:],
+                              diameter)
+    return _profile(report, vertices[first:], s_rest[first:], diameter)
+
+
 def _builder_rod(points: np.ndarray, diameter: float, youngs_modulus: float) -> tuple:
     from tightknot.rods.builder import RodBuilder
     from tightknot.rods.material import Material
@@ -186,8 +200,8 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
             "area_ratio_mid_b": prof_b[n_obs // 2]["area_ratio"],
             "peak_pressure_over_e": prof_a[mid]["peak_pressure_over_e"],
             "contact_fraction_max": max(r["contact_fraction"] for r in prof_a),
-            "profile_a": prof_a[mid:],
-            "profile_b": prof_b[n_obs // 2:],
+            "profile_a": _along(rep, rod_v, s_a, d0, mid),
+            "profile_b": _along(rep, obs_v, s_b, d0, n_obs // 2),
         }
 
     rows = _solve_levels(system, load, list(tension_levels), measure)
@@ -283,7 +297,6 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
         force = -float(g[va, 0].sum())
         rep = _report(term, system)
         prof_a = _profile(rep, va[apex:], s[apex:], d0)
-        prof_b = _profile(rep, vb[apex:], s[apex:], d0)
         xa = x[va]
         e = np.linalg.norm(np.diff(xa, axis=0), axis=1)
         stretch = float(0.5 * (e[apex - 1] + e[apex]) / (s[1] - s[0]))
@@ -299,8 +312,8 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
             "area_ratio_min": min(r["area_ratio"] for r in prof_a),
             "peak_pressure_over_e": max(r["peak_pressure_over_e"] for r in prof_a),
             "contact_fraction_max": max(r["contact_fraction"] for r in prof_a),
-            "profile_a": prof_a,
-            "profile_b": prof_b,
+            "profile_a": _along(rep, va, s, d0, apex),
+            "profile_b": _along(rep, vb, s, d0, apex),
         }
 
     rows = _solve_levels(system, load, list(pull_levels), measure) if relaxed else []
@@ -394,8 +407,9 @@ def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
                                for r, k in enumerate(levels) if k * side > 0])
 
     above, below = rods(1), rods(-1)
-    # rod A's vertices from the crossing on, with their rest arc length from it
-    va = np.arange(a_v, model.rods[0].vertex_start + edges[0] + 1)
+    # rod A's vertices from the one before the crossing on, with their rest arc length
+    # from the crossing
+    va = np.arange(a_v - 1, model.rods[0].vertex_start + edges[0] + 1)
     s_a = (va - a_v) * (length_over_d0 * d0 / edges[0])
 
     def measure(w: float) -> dict[str, Any]:
@@ -411,7 +425,7 @@ def rod_soft_crossing(w_levels: list[float], diameter: float = ROD_DIAMETER,
             "peak_pressure_over_e": float(rep.peak_pressure_over_E[a_v]),
             "contact_width_fraction_mid": float(rep.contact_width_fraction[a_v]),
             "contact_weight_sum_mean": rep.weight_sum_mean,
-            "profile_a": _profile(rep, va, s_a, d0),
+            "profile_a": _along(rep, va, s_a, d0, 1),
         }
 
     rows = _solve_levels(system, load, list(w_levels), measure)

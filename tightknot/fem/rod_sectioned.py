@@ -43,13 +43,15 @@ def _report(layer: Any, system: Any) -> dict[str, np.ndarray]:
 
 def _outward_profile(rep: dict[str, np.ndarray], verts: np.ndarray, h: float,
                      diameter: float) -> list[dict[str, float]]:
-    """A/A0, L_c and p_max/E per vertex of ``verts`` (the middle first, then outward, rest
-    edge length ``h`` [m]) at rest arc length ``s_over_d0`` from the middle: the rows of
-    the FEM's ``profile_a`` (:mod:`tightknot.fem.profile_compare`)."""
-    return [{"s_over_d0": k * h / diameter, "area_ratio": float(rep["area_ratio"][u]),
-             "contact_fraction": float(rep["contact_width_fraction"][u]),
-             "peak_pressure_over_e": float(rep["peak_pressure_over_E"][u])}
-            for k, u in enumerate(verts)]
+    """A/A0, L_c and p_max/E at the Gauss circles of the edges from the vertex before the
+    middle ``verts[0]`` outward along ``verts`` (rest edge length ``h`` [m]), at rest arc
+    length ``s_over_d0`` from the middle: the rows of the FEM's ``profile_a``
+    (:func:`tightknot.fem.profile_compare.circle_profile`; the edge before the middle
+    puts s = 0 inside the profile)."""
+    from tightknot.fem.profile_compare import circle_profile
+
+    verts = np.concatenate([[verts[0] - 1], verts])
+    return circle_profile(rep, verts, (np.arange(verts.size) - 1.0) * h, diameter)
 
 
 def rod_indent_sectioned(w_levels: list[float], diameter: float = ROD_DIAMETER,
