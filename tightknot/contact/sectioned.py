@@ -1132,7 +1132,7 @@ class SectionedLayer(ContactLayer):
                             kappa * (g - 0.5 * onset))
             t = np.maximum(weight, 0.0) * dphi
             touch = np.flatnonzero((t > 0.0).any(axis=(1, 2)))  # the passes in contact
-            np.add.at(press, owner[touch], t[touch])
+            press += _row_sums(owner[touch], t[touch], n_e)
         # the deformed boundary's length element r ds at each sample, per Gauss circle
         c0, c1 = self.edge_sections(extra, frames[2])
         phis = 2.0 * math.pi * (np.arange(ms) + 0.5) / ms
@@ -1248,12 +1248,18 @@ def _per_sample(owner: np.ndarray, pen: np.ndarray, weight: np.ndarray, edge_cou
                 ) -> tuple[np.ndarray, np.ndarray]:
     """Per edge, Gauss circle and sample: the sum of the passes' weights and the weighted
     penetration [m] (the passes of :meth:`SectionedLayer.sample_passes`)."""
-    shape = (edge_count,) + pen.shape[1:]
-    sums, pens = np.zeros(shape), np.zeros(shape)
     w = np.maximum(weight, 0.0)
-    np.add.at(sums, owner, w)
-    np.add.at(pens, owner, w * np.maximum(pen, 0.0))
-    return sums, pens
+    return (_row_sums(owner, w, edge_count),
+            _row_sums(owner, w * np.maximum(pen, 0.0), edge_count))
+
+
+def _row_sums(owner: np.ndarray, values: np.ndarray, count: int) -> np.ndarray:
+    """Per row index r < ``count``: the sum of the ``values`` rows whose ``owner`` is r
+    (``np.add.at`` into zeros, in the same order, by one ``np.bincount``)."""
+    inner = int(np.prod(values.shape[1:], dtype=np.int64))
+    idx = (np.asarray(owner, dtype=np.int64)[:, None] * inner + np.arange(inner)).ravel()
+    sums = np.bincount(idx, weights=values.reshape(-1), minlength=count * inner)
+    return sums.reshape((count,) + values.shape[1:])
 
 
 def _weight_sum_mean(owner: np.ndarray, pen: np.ndarray, weight: np.ndarray,
