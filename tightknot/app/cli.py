@@ -397,7 +397,7 @@ def build_parser() -> argparse.ArgumentParser:
     from tightknot.sweep.commands import register as register_sweep
 
     register_knots(sub)
-    register_fem(sub, draw_profiles=_draw_soft_profiles)
+    register_fem(sub, draw_profiles=_draw_profiles)
     register_bench(sub)
     register_sweep(sub)
     from tightknot.app.sweep_outputs import register as register_sweep_outputs
@@ -406,13 +406,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _draw_soft_profiles(soft_scenes: dict, level: str, path: str) -> list[str]:
-    """``tightknot fem crosscheck --figure``: the soft scenes' profiles side by side
-    (:func:`tightknot.viz.profile_figures.plot_soft_profiles`, imported when drawn: it
-    loads matplotlib)."""
-    from tightknot.viz.profile_figures import plot_soft_profiles
+def _draw_profiles(path: str, level: str, soft: dict | None, rigid: dict | None
+                   ) -> list[str]:
+    """``tightknot fem crosscheck --figure``: the scenes' profiles side by side
+    (:func:`tightknot.viz.profile_figures.plot_profiles`, imported when drawn: it loads
+    matplotlib)."""
+    from tightknot.viz.profile_figures import plot_profiles
 
-    return plot_soft_profiles(soft_scenes, level, path)
+    return plot_profiles(path, level, soft=soft, rigid=rigid)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

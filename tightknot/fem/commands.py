@@ -37,9 +37,10 @@ _CAL_EXAMPLES = """examples:
 
 def register(subparsers: Any, draw_profiles: Callable[..., Any] | None = None) -> None:
     """Add the ``fem`` and ``calibrate`` subcommands to an argparse ``subparsers``;
-    ``draw_profiles(soft_scenes, level, path)`` draws ``crosscheck --figure`` (the command
-    line passes :func:`tightknot.viz.profile_figures.plot_soft_profiles`: pictures are a
-    layer above the FEM's)."""
+    ``draw_profiles(path, level, soft_scenes, scenes)`` draws ``crosscheck --figure``
+    from the report's soft and rigid scenes (the command line passes
+    :func:`tightknot.viz.profile_figures.plot_profiles`: pictures are a layer above the
+    FEM's)."""
     fem = subparsers.add_parser(
         "fem", help="run a small 3D solid FEM scene (needs tightknot[fem])",
         description="Run a FEM contact scene of a nearly incompressible neo-Hookean rod "
@@ -108,9 +109,10 @@ def register(subparsers: Any, draw_profiles: Callable[..., Any] | None = None) -
                           "and mesh winning; a scene on the next finer mesh is compared "
                           "too (the FEM's third mesh, reported)")
     fem.add_argument("--figure", default=None, metavar="PNG",
-                     help="crosscheck only: draw the two-soft-rod scenes' profiles along "
-                          "the contact (L_c, A/A0, p/E; FEM and rod model side by side) to "
-                          "this PNG (needs the soft scenes: not with --no-soft)")
+                     help="crosscheck only: draw the scenes' profiles along the contact "
+                          "(L_c, A/A0, p/E; FEM and rod model side by side) to this PNG: "
+                          "the two-soft-rod scenes, and with --contact sectioned the "
+                          "indent and the wrap too (with --no-soft only those)")
     fem.set_defaults(handler=_run_fem, draw_profiles=draw_profiles)
 
     cal = subparsers.add_parser(
@@ -199,8 +201,9 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
     problem = _check_out(args.json) or _check_out(args.figure)
     if problem:
         return _fail(problem)
-    if args.figure is not None and args.no_soft:
-        return _fail("--figure draws the soft scenes' profiles: it cannot go with --no-soft")
+    if args.figure is not None and args.no_soft and args.contact != "sectioned":
+        return _fail("--figure with --no-soft draws the indent's and the wrap's profiles, "
+                     "which only --contact sectioned reports")
     if args.figure is not None and not args.figure.endswith(".png"):
         return _fail(f"--figure must name a .png file, got {args.figure!r}")
     if args.figure is not None and args.draw_profiles is None:
@@ -235,7 +238,8 @@ def _run_crosscheck(args: argparse.Namespace) -> int:
 
         write_json_atomic(args.json, report)
     if args.figure is not None:
-        args.draw_profiles(report["soft_scenes"], report["contact"], args.figure)
+        args.draw_profiles(args.figure, report["contact"], report.get("soft_scenes"),
+                           report["scenes"])
     summary = {name: scene["comparison"]["worst"] for name, scene in report["scenes"].items()}
     line = {"contact": report["contact"], "passed": report["passed"],
             "fem_over_rod_time_ratio": report["fem_over_rod_time_ratio"], "worst": summary}
