@@ -248,6 +248,7 @@ def test_soft_rows_of_the_sectioned_level_with_the_bend_shift(
     json.dumps(rows, allow_nan=False)
     assert set(rows["levels"]) == {"sectioned"}
     assert rows["passed"] == rows["levels"]["sectioned"]["passed"]
+    assert rows["rod_edges_per_d0"] == 12  # the rods' resolution, reported
     clasp = rows["levels"]["sectioned"]["scenes"]["clasp"]
     assert abs(clasp["kinematic_offset"]["clamp_travel_over_d0"]) < 0.06
     for name in ("soft_wrap", "clasp", "soft_crossing"):
@@ -273,3 +274,38 @@ def test_cli_fem_json_bad_files_exit_2(tmp_path, capsys):
     assert main(["fem", "crosscheck", "--fem-json", str(other)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"--fem-json {other}: neither a crosscheck report" in err[0]
+
+
+def test_the_rod_runs_take_the_resolution_to_every_soft_scene(monkeypatch) -> None:
+    # `tightknot fem crosscheck --contact sectioned --rod-edges-per-d0 N` refines the
+    # two-soft-rod scenes' rods too, not only the indent's and the wrap's: rod_runs hands
+    # its edges_per_d0 to each scene (here recorded by stand-ins of the three scenes).
+    from tightknot.fem import rod_model_soft
+    from tightknot.fem.crosscheck_soft import rod_runs
+
+    seen = {}
+
+    def stand_in(name):
+        def run(levels, **kw):
+            seen[name] = kw["edges_per_d0"]
+            return {"steps": [], "relaxed": False}
+        return run
+
+    for name in ("rod_soft_wrap", "rod_clasp", "rod_soft_crossing"):
+        monkeypatch.setattr(rod_model_soft, name, stand_in(name))
+    par = {"diameter_m": 0.0085, "youngs_modulus_pa": 1.25e6, "segment_length_m": 0.03,
+           "wrap_angle_deg": 90.0, "bend_radius_m": 0.01, "leg_length_m": 0.01,
+           "initial_gap_m": 0.0}
+    fem = {name: {"parameters": par, "steps": []}
+           for name in ("soft_wrap", "clasp", "soft_crossing")}
+    rod_runs(fem, "sectioned", edges_per_d0=24)
+    assert seen == {"rod_soft_wrap": 24, "rod_clasp": 24, "rod_soft_crossing": 24}
+
+
+def test_a_bad_resolution_of_the_soft_scenes_is_refused_before_they_run() -> None:
+    from tightknot.fem.rod_model_soft import rod_clasp, rod_soft_wrap
+
+    with pytest.raises(ValueError, match="edges_per_d0"):
+        rod_clasp([0.01], edges_per_d0=3)
+    with pytest.raises(ValueError, match="edges_per_d0"):
+        rod_soft_wrap([1.0], edges_per_d0=2.5)

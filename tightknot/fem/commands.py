@@ -99,9 +99,9 @@ def register(subparsers: Any, draw_profiles: Callable[..., Any] | None = None) -
                           "sections, each edge's own (default) or the rod's mean "
                           "(docs/sectioned_level.md, 'Resolution')")
     fem.add_argument("--rod-edges-per-d0", type=int, default=None, metavar="N",
-                     help="crosscheck --contact sectioned: edges per D0 of the rod scenes "
-                          "(default 12; the 0.012 D0 indent needs 24 or more, "
-                          "docs/sectioned_level.md, 'Resolution')")
+                     help="crosscheck --contact sectioned: edges per D0 of the rod scenes, "
+                          "the rigid and the two-soft-rod ones (default 12; the 0.012 D0 "
+                          "indent needs 24 or more, docs/sectioned_level.md, 'Resolution')")
     fem.add_argument("--fem-json", default=None, nargs="+", metavar="FILE",
                      help="crosscheck only: reuse FEM results instead of running them: "
                           "earlier crosscheck reports (their fem_results) or scene results "

@@ -404,8 +404,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
     ``contact`` (:data:`CONTACT_LEVELS`; ``section_modes``: the sectioned level's N,
     ``bend_shift``: its sections centred on the bend's offset centreline, ``thinning``:
     the stretch that thins them, :class:`~tightknot.contact.sectioned.SectionSettings`;
-    ``rod_edges_per_d0``: the sectioned rod scenes' resolution, docs/sectioned_level.md,
-    "Resolution") and
+    ``rod_edges_per_d0``: the sectioned rod scenes' resolution, the two-soft-rod scenes'
+    too, docs/sectioned_level.md, "Resolution") and
     compare them; with ``soft``, also the two-soft-rod scenes soft_wrap, clasp and
     soft_crossing (:mod:`tightknot.fem.crosscheck_soft`: key ``soft_scenes``, at every level of
     :data:`~tightknot.fem.rod_model_soft.CONTACT_LEVELS` in a compliant report, at the
@@ -459,7 +459,8 @@ def crosscheck(mesh: str = DEFAULT_MESH, fem_results: dict[str, dict] | None = N
             section = SectionSettings(max_mode=section_modes, bend_shift=bend_shift,
                                       thinning=thinning)
             report["soft_scenes"] = soft_rows(mesh, fem_results, section=section,
-                                              levels=("sectioned",))
+                                              levels=("sectioned",),
+                                              edges_per_d0=rod_edges_per_d0)
             report["fem_results"].update({k: v for k, v in fem_results.items()
                                           if k not in ("indent", "wrap")})
             report["passed"] = report["passed"] and report["soft_scenes"]["passed"]

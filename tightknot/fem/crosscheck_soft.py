@@ -64,6 +64,7 @@ from typing import Any
 
 from .crosscheck_targets import APPROACH_LIMIT, TARGETS
 from .profile_compare import along_contact, spread_summary
+from .rod_model import EDGES_PER_D0
 from .scenes._common import MESH_LEVELS, relative
 
 ROW_SCENES: tuple[str, ...] = ("soft_wrap", "clasp", "soft_crossing")
@@ -171,13 +172,13 @@ def clasp_kinematic_offset(fem_relaxed: dict[str, float], rod: dict[str, Any]
 
 
 def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_SCENES,
-             law: Any = None) -> dict[str, dict]:
+             law: Any = None, edges_per_d0: int = EDGES_PER_D0) -> dict[str, dict]:
     """The rod model of ``scenes`` (default the soft rows', :data:`ROW_SCENES`) at the FEM's
     load levels and parameters (``fem`` holds each scene's FEM result), at level
     ``contact`` (a compliant or smoothed level with the pair law ``law``, default the
-    shipped one); with the clasp and the FEM's relaxed U's at hand also the clasp with the
-    kinematics matched (key "clasp_matched", its ``kinematic_offset``,
-    :func:`clasp_kinematic_offset`)."""
+    shipped one) and ``edges_per_d0`` (the rods' resolution); with the clasp and the FEM's
+    relaxed U's at hand also the clasp with the kinematics matched (key "clasp_matched",
+    its ``kinematic_offset``, :func:`clasp_kinematic_offset`)."""
     from .rod_model_soft import rod_clasp, rod_soft_crossing, rod_soft_wrap
 
     unknown = [name for name in scenes if name not in ROW_SCENES]
@@ -190,7 +191,7 @@ def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_S
                              wrap_angle_deg=wp["wrap_angle_deg"], diameter=wp["diameter_m"],
                              youngs_modulus=wp["youngs_modulus_pa"],
                              length_over_d0=wp["segment_length_m"] / wp["diameter_m"],
-                             contact=contact, law=law)
+                             contact=contact, law=law, edges_per_d0=edges_per_d0)
 
     def clasp(gap: float | None = None) -> dict[str, Any]:
         # gap None: the FEM's own initial gap
@@ -201,7 +202,7 @@ def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_S
                          bend_radius_over_d0=cp["bend_radius_m"] / d0,
                          leg_length_over_d0=cp["leg_length_m"] / d0, diameter=d0,
                          youngs_modulus=cp["youngs_modulus_pa"], contact=contact,
-                         initial_gap=gap, law=law)
+                         initial_gap=gap, law=law, edges_per_d0=edges_per_d0)
 
     def soft_crossing() -> dict[str, Any]:
         xp = fem["soft_crossing"]["parameters"]
@@ -209,7 +210,7 @@ def rod_runs(fem: dict[str, dict], contact: Any, scenes: tuple[str, ...] = ROW_S
             [s["w_over_d0"] * xp["diameter_m"] for s in fem["soft_crossing"]["steps"]],
             diameter=xp["diameter_m"], youngs_modulus=xp["youngs_modulus_pa"],
             length_over_d0=xp["segment_length_m"] / xp["diameter_m"], contact=contact,
-            law=law)
+            law=law, edges_per_d0=edges_per_d0)
 
     build = {"soft_wrap": soft_wrap, "clasp": clasp, "soft_crossing": soft_crossing}
     runs = {name: build[name]() for name in ROW_SCENES if name in scenes}
@@ -389,10 +390,12 @@ def finer_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
-              section: Any = None, levels: tuple[str, ...] | None = None) -> dict[str, Any]:
+              section: Any = None, levels: tuple[str, ...] | None = None,
+              edges_per_d0: int = EDGES_PER_D0) -> dict[str, Any]:
     """The report's ``soft_scenes`` entry: the FEM runs (:func:`fem_runs`), the rod model at
     each of ``levels`` (default :data:`CONTACT_LEVELS`; the sectioned level with the
-    settings ``section`` where given), and their comparisons (:func:`compare`); ``passed``
+    settings ``section`` where given) and ``edges_per_d0`` (its rods' resolution,
+    reported as ``rod_edges_per_d0``), and their comparisons (:func:`compare`); ``passed``
     is the first level's, the compliant one by default (both scenes, every target, the rod
     model at least 1000 times faster than the FEM on each scene)."""
     fem = fem_runs(mesh, fem_results)
@@ -407,7 +410,7 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
     for contact in names:
         start = time.perf_counter()
         rod = rod_runs(fem, section if (contact == "sectioned" and section is not None)
-                        else contact)
+                        else contact, edges_per_d0=edges_per_d0)
         scenes = {}
         for name in ROW_SCENES:
             ref = fem.get(f"{name}@{spread}") if spread else None
@@ -443,5 +446,6 @@ def soft_rows(mesh: str, fem_results: dict[str, dict] | None = None,
                        "spread_steps": (fem[f"{name}@{spread}"]["steps"] if spread else None)}
                 for name in ROW_SCENES},
         "levels": levels,
+        "rod_edges_per_d0": edges_per_d0,
         "passed": levels[names[0]]["passed"],
     }

@@ -31,6 +31,7 @@ from .rod_model import (
     EDGES_PER_D0,
     WRAP_START_OVERLAP,
     _solve_levels,
+    check_edges_per_d0,
     wrap_scene,
 )
 from .rod_sectioned import axis_reading, far_fibre_axis
@@ -127,12 +128,13 @@ def _builder_rod(points: np.ndarray, diameter: float, youngs_modulus: float) -> 
 def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
                   diameter: float = ROD_DIAMETER, youngs_modulus: float = YOUNGS_MODULUS,
                   length_over_d0: float = 4.5, law: Any = None,
-                  contact: str = "compliant") -> dict[str, Any]:
+                  contact: str = "compliant", edges_per_d0: int = EDGES_PER_D0
+                  ) -> dict[str, Any]:
     """The soft wrap with the rod model: rod A (axis e_z at rest) pulled by dead end forces
     T (0, sin(theta), +-cos(theta)) [N] (``tension_levels``) around rod B along e_x, held
     as the FEM scene's stack holds it (:func:`tightknot.fem.rod_model.wrap_scene` with
     ``stack``: B pressed by A and A's mirror image, its axis straight, free to stretch
-    along it), with the soft pair law.
+    along it), with the soft pair law; ``edges_per_d0``: both rods' resolution.
 
     Returns per level the keys of :func:`tightknot.fem.rod_model.rod_wrap` (the mid line
     load per length of the nominal axis, its curvature and approach, overlap, A/A0, peak
@@ -148,7 +150,8 @@ def rod_soft_wrap(tension_levels: list[float], wrap_angle_deg: float = 90.0,
     d0 = diameter
     # The rigid wrap's rods and constraints, B held as the FEM's stack holds it (a pinned
     # B could not thin where it is pressed, as the solid's does).
-    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg, stack=True)
+    scene = wrap_scene(diameter, youngs_modulus, length_over_d0, wrap_angle_deg,
+                       edges_per_d0=edges_per_d0, stack=True)
     system, load, model = scene.system, scene.load, scene.model
     n_rod, n_obs, mid, half = scene.n_rod, scene.n_obs, scene.mid, scene.half
     y_obs = d0 - WRAP_START_OVERLAP * d0
@@ -233,11 +236,13 @@ def clasp_centrelines(bend_radius: float, leg_length: float, diameter: float,
 def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
               leg_length_over_d0: float = 1.5, diameter: float = ROD_DIAMETER,
               youngs_modulus: float = YOUNGS_MODULUS, law: Any = None,
-              contact: str = "compliant", initial_gap: float = 0.0) -> dict[str, Any]:
+              contact: str = "compliant", initial_gap: float = 0.0,
+              edges_per_d0: int = EDGES_PER_D0) -> dict[str, Any]:
     """The clasp with the rod model: two U's (straight at rest, started on the FEM
     scene's U and clamped where it clamps its rods, the FEM's start gap ``initial_gap``
-    [m], :func:`clasp_centrelines`), each end clamped (its two end vertices held),
-    relaxed, then the clamps moved apart along x by ``pull_levels`` [m] (half each).
+    [m], :func:`clasp_centrelines` at ``edges_per_d0``), each end clamped (its two end
+    vertices held), relaxed, then the clamps moved apart along x by ``pull_levels`` [m]
+    (half each).
 
     Returns per level: ``force`` [N] (the x contact force on A: the pull, by statics),
     ``approach_over_d0`` (D0 minus the apex vertices' distance), ``kappa_d0_apex``,
@@ -258,8 +263,9 @@ def rod_clasp(pull_levels: list[float], bend_radius_over_d0: float = 1.5,
     start = time.perf_counter()
     check_contact(contact)
     d0 = diameter
+    check_edges_per_d0(edges_per_d0)
     curves, s = clasp_centrelines(bend_radius_over_d0 * d0, leg_length_over_d0 * d0, d0,
-                                  initial_gap=initial_gap)
+                                  edges_per_d0, initial_gap=initial_gap)
     model = _builder_rod(curves, d0, youngs_modulus)
     n = len(s) - 1
     apex = n // 2
@@ -343,7 +349,7 @@ def soft_crossing_scene(diameter: float, youngs_modulus: float, length_over_d0: 
     from tightknot.rods.state import State
     from tightknot.solvers.system import RodSystem
 
-    from .rod_model import _line_points, check_edges_per_d0
+    from .rod_model import _line_points
 
     check_edges_per_d0(edges_per_d0)
     if isinstance(depth, bool) or not isinstance(depth, int) or depth < 1:
