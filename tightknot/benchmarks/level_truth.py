@@ -25,6 +25,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from tightknot.fem.rod_model import EDGES_PER_D0
+
 #: What the table says of the rigid level's FEM errors.
 RIGID_REASON = ("a rigid tube has no contact compliance: against the FEM's rigid "
                 "counter-bodies its force is set by the constraint, not by an approach")
@@ -138,6 +140,7 @@ def level_truth(crosscheck: dict[str, Any], contact_levels: dict | None = None,
         shift = bool(sec.get("section_bend_shift", False))
         rows.append({"level": "sectioned", **_scene_errors(sec["scenes"]),
                      "section_modes": sec.get("section_modes"),
+                     "rod_edges_per_d0": sec.get("rod_edges_per_d0"),
                      "rod_wall_time_s": sec["rod_wall_time_s"],
                      "fem_over_rod_time_ratio": sec["fem_over_rod_time_ratio"],
                      "section_bend_shift": shift,
@@ -185,6 +188,9 @@ def format_table(table: dict[str, Any]) -> str:
         area = max(row["indent_area_points_max"] or 0.0, row["wrap_area_points_max"] or 0.0)
         soft = row.get("soft") or {}
         name = row["level"] + (" + bend shift" if row.get("section_bend_shift") else "")
+        edges = row.get("rod_edges_per_d0")
+        if edges is not None and edges != EDGES_PER_D0:
+            name += f", {edges} edges per D0"  # the rod scenes' resolution, not the default
         lines.append(
             f"| {name} | {_pct(row['indent_force_rel'])} | "
             f"{_pct(row['wrap_line_load_rel'])} | {_pct(soft.get('soft_wrap_force_rel'))} | "
