@@ -279,10 +279,11 @@ def test_the_sectioned_level_reuses_the_fem_and_joins_the_table(report):
     assert all(t.count("|") == shift_line.count("|") for t in text.splitlines()
                if t.startswith("| "))
     assert "soft wrap and the clasp at compliant, smoothed, sectioned" in table["not_covered"]
-    # a report at another rod resolution says so in its row's name
+    # reports at two rod resolutions name them in their rows (one alone does not)
     finer = {**sec, "rod_edges_per_d0": 24}
     text = format_table(level_truth(report, None, [sec, finer]))
-    assert "| sectioned, 24 edges per D0 |" in text and "| sectioned |" in text
+    assert "| sectioned, 24 edges per D0 |" in text
+    assert f"| sectioned, {sec['rod_edges_per_d0']} edges per D0 |" in text
 
 
 def test_each_compared_level_has_the_fem_spread_beside_it() -> None:

@@ -25,8 +25,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from tightknot.fem.rod_model import EDGES_PER_D0
-
 #: What the table says of the rigid level's FEM errors.
 RIGID_REASON = ("a rigid tube has no contact compliance: against the FEM's rigid "
                 "counter-bodies its force is set by the constraint, not by an approach")
@@ -176,6 +174,8 @@ def format_table(table: dict[str, Any]) -> str:
              "clasp L_c along the contact, max | "
              "rod time [s] | FEM / rod time | knots' time / compliant |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    # the rod scenes' resolution names a sectioned row where the rows differ in it
+    resolutions = {r.get("rod_edges_per_d0") for r in table["rows"] if r["level"] == "sectioned"}
     for row in table["rows"]:
         knots = row.get("knots")
         kt = ("n/a" if not knots or knots["time_ratio_to_compliant"] is None else
@@ -188,9 +188,8 @@ def format_table(table: dict[str, Any]) -> str:
         area = max(row["indent_area_points_max"] or 0.0, row["wrap_area_points_max"] or 0.0)
         soft = row.get("soft") or {}
         name = row["level"] + (" + bend shift" if row.get("section_bend_shift") else "")
-        edges = row.get("rod_edges_per_d0")
-        if edges is not None and edges != EDGES_PER_D0:
-            name += f", {edges} edges per D0"  # the rod scenes' resolution, not the default
+        if len(resolutions) > 1 and row.get("rod_edges_per_d0") is not None:
+            name += f", {row['rod_edges_per_d0']} edges per D0"
         lines.append(
             f"| {name} | {_pct(row['indent_force_rel'])} | "
             f"{_pct(row['wrap_line_load_rel'])} | {_pct(soft.get('soft_wrap_force_rel'))} | "
