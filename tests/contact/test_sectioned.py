@@ -801,11 +801,9 @@ def test_the_reported_traction_is_the_one_the_energy_applies(step: float) -> Non
         assert reported == pytest.approx(force, rel=0.05)
 
 
-def test_on_a_straight_partner_the_passes_weights_sum_to_one() -> None:
-    # The partner's surface is blended over its edges by hats that sum to one along a
-    # straight partner (the calibration's and the cross-check's straight scenes rely on
-    # it; on a bent one they do not: bench/partition_sum.py). Two straight rods crossing
-    # over a vertex of B: every sample of A in contact gets weights summing to one.
+def _straight_crossing() -> tuple:
+    """Two straight rods of 24 edges crossing at 90 degrees near B's middle vertex, A
+    pressed 0.03 D0 into B: the model, its rod system and the sectioned layer (N = 6)."""
     mat = Material(1.25e6, 0.5, 1160.0)
     b = RodBuilder(twist=False)
     z = np.linspace(-1.5 * D0, 1.5 * D0, 25)
@@ -815,6 +813,15 @@ def test_on_a_straight_partner_the_passes_weights_sum_to_one() -> None:
     system = RodSystem(model, State.initial(model), BoundaryConditions(model))
     layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=64))
     system.add_term(layer)
+    return model, system, layer
+
+
+def test_on_a_straight_partner_the_passes_weights_sum_to_one() -> None:
+    # The partner's surface is blended over its edges by hats that sum to one along a
+    # straight partner (the calibration's and the cross-check's straight scenes rely on
+    # it; on a bent one they do not: bench/partition_sum.py). Two straight rods crossing
+    # over a vertex of B: every sample of A in contact gets weights summing to one.
+    model, system, layer = _straight_crossing()
     st = system.state
     owner, partner, pen, weight = layer.sample_passes(st.x, np.zeros(layer.dof_count),
                                                       st.frames, system.rest)
@@ -840,16 +847,7 @@ def test_a_vertex_reports_the_largest_of_its_edges_circles() -> None:
     # The report per vertex (the knots' maps, the mid rows of the cross-check) is the
     # largest of the Gauss circles of the vertex's edges; the profiles along the contact
     # read the circles at their own places (tightknot.fem.profile_compare.circle_profile).
-    # Two straight rods crossing between two of B's vertices, A pressed 0.03 D0 in.
-    mat = Material(1.25e6, 0.5, 1160.0)
-    b = RodBuilder(twist=False)
-    z = np.linspace(-1.5 * D0, 1.5 * D0, 25)
-    b.add_rod(np.c_[np.full(25, 0.3 * D0 / 12), np.zeros(25), z], D0, mat)
-    b.add_rod(np.c_[z, np.full(25, 0.97 * D0), np.zeros(25)], D0, mat)
-    model = b.finalize()
-    system = RodSystem(model, State.initial(model), BoundaryConditions(model))
-    layer = SectionedLayer(model, SectionSettings(max_mode=6, samples=64))
-    system.add_term(layer)
+    model, system, layer = _straight_crossing()
     st = system.state
     rep = layer.section_report(st.x, np.zeros(layer.dof_count), st.frames, system.rest)
     width = rep["circle_contact_width_fraction"]
