@@ -52,12 +52,12 @@ def circle_profile(circles: dict[str, np.ndarray], vertices: np.ndarray,
     length [D0], in the order of ``vertices``."""
     ev = np.asarray(circles["edge_vertex"])
     edge_of = {(int(a), int(b)): e for e, (a, b) in enumerate(ev)}
+    u_first = np.asarray(circles["circle_u"], dtype=float)
     rows = []
     for (va, sa), (vb, sb) in zip(zip(vertices[:-1], s_rest[:-1], strict=True),
                                   zip(vertices[1:], s_rest[1:], strict=True), strict=True):
         e = edge_of.get((int(va), int(vb)))
-        us = np.asarray(circles["circle_u"], dtype=float)
-        order = np.arange(us.size)
+        us, order = u_first, np.arange(u_first.size)
         if e is None:  # the edge runs from vb to va: its circles from va's end first
             e = edge_of.get((int(vb), int(va)))
             us, order = 1.0 - us[::-1], order[::-1]
